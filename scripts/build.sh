@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Sets up the dependencies (scripts/setup_deps.sh) and builds rig_calibrator into
+# build/ (or $RIG_CALIBRATOR_BUILD_DIR). The executable is build/rig_calibrator.
+set -euo pipefail
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cache="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}"
+build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+jobs="$(nproc 2>/dev/null || echo 2)"
+
+bash "$repo/scripts/setup_deps.sh"
+
+echo "[build] configuring and building rig_calibrator in $build"
+cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$cache/colmap-3.8" > /dev/null \
+  || { echo "[build] ERROR: configuring failed (run cmake in $build to see why)" >&2; exit 1; }
+cmake --build "$build" -j"$jobs" \
+  || { echo "[build] ERROR: compiling failed (see the messages above)" >&2; exit 1; }
+echo "[build] done: $build/rig_calibrator"

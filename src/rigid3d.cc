@@ -1,0 +1,47 @@
+#include "src/rigid3d.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+namespace rig_calibrator {
+
+Eigen::Matrix<double, 3, 4> Rigid3d::ToMatrix() const {
+  Eigen::Matrix<double, 3, 4> matrix;
+  matrix.leftCols<3>() = RotationMatrix();
+  matrix.col(3) = translation;
+  return matrix;
+}
+
+Rigid3d Rigid3d::Inverse() const {
+  const Eigen::Quaterniond inverse_rotation = rotation.conjugate();
+  return Rigid3d(inverse_rotation, -(inverse_rotation * translation));
+}
+
+Rigid3d Rigid3d::FromQvecTvec(const Eigen::Vector4d& qvec,
+                              const Eigen::Vector3d& tvec) {
+  return Rigid3d(Eigen::Quaterniond(qvec(0), qvec(1), qvec(2), qvec(3)), tvec);
+}
+
+Rigid3d operator*(const Rigid3d& a_from_b, const Rigid3d& b_from_c) {
+  return Rigid3d(a_from_b.rotation * b_from_c.rotation,
+                 a_from_b.rotation * b_from_c.translation +
+                     a_from_b.translation);
+}
+
+double RotationDifferenceDeg(const Eigen::Quaterniond& a,
+                             const Eigen::Quaterniond& b) {
+  // |w| of a^-1 b is cos(angle / 2); the clamp guards against rounding.
+  const double w = std::min(1.0, std::abs((a.conjugate() * b).normalized().w()));
+  return 2.0 * std::acos(w) * 180.0 / M_PI;
+}
+
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+      matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() > 0 ? 1 : -1;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+}  // namespace rig_calibrator

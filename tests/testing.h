@@ -1,0 +1,31 @@
+// Helpers shared by the tests.
+#pragma once
+
+#include <string>
+
+namespace rig_calibrator {
+namespace testing {
+
+// A fresh, empty folder under the system's temporary folder, removed with
+// everything in it when the object goes out of scope.
+class ScopedTempDir {
+ public:
+  ScopedTempDir();
+  ~ScopedTempDir();
+  ScopedTempDir(const ScopedTempDir&) = delete;
+  ScopedTempDir& operator=(const ScopedTempDir&) = delete;
+
+  const std::string& path() const { return path_; }
+  // path() + "/" + name.
+  std::string File(const std::string& name) const;
+
+ private:
+  std::string path_;
+};
+
+// The repository's root and the build tree, as configured by CMake.
+std::string SourceDir();
+std::string BinaryDir();
+
+}  // namespace testing
+}  // namespace rig_calibrator
