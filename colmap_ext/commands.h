@@ -18,4 +18,7 @@ int RunEvaluate(int argc, char** argv);
 // Writes a synthetic rig dataset (2D-3D correspondences) with its ground truth.
 int RunSynthetic(int argc, char** argv);
 
+// The paper's short-sequence robustness experiment on synthetic rigs.
+int RunBenchmark(int argc, char** argv);
+
 }  // namespace rig_calibrator

@@ -3,7 +3,7 @@
 //   rig_calibrator [calibrate] --database_path ... --image_path ... \
 //                  --input_path ... --output_path ...
 //   rig_calibrator evaluate ...
-//   rig_calibrator synthetic ...
+//   rig_calibrator synthetic | render | benchmark ...
 //
 // The first form is the default command; `rig_calibrator help` lists all.
 #include <cstring>
@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "colmap_ext/commands.h"
+#include "colmap_ext/render_command.h"
 
 namespace {
 
@@ -33,6 +34,12 @@ Commands() {
           {"synthetic",
            {&rig_calibrator::RunSynthetic,
             "write a synthetic rig dataset with exact ground truth"}},
+          {"render",
+           {&rig_calibrator::RunRender,
+            "render images of a textured scene for a map and a rig"}},
+          {"benchmark",
+           {&rig_calibrator::RunBenchmark,
+            "robustness of the methods on short sequences (paper 5.3)"}},
       };
   return commands;
 }

@@ -32,6 +32,7 @@ packages=(
   libboost-program-options-dev libboost-filesystem-dev libboost-graph-dev
   libboost-regex-dev libboost-system-dev libboost-test-dev
   libgtest-dev googletest sqlite3 python3 python3-numpy nlohmann-json3-dev libyaml-cpp-dev
+  ccache
 )
 
 missing_packages() {

@@ -31,9 +31,11 @@ Rigid3d operator*(const Rigid3d& a_from_b, const Rigid3d& b_from_c) {
 
 double RotationDifferenceDeg(const Eigen::Quaterniond& a,
                              const Eigen::Quaterniond& b) {
-  // |w| of a^-1 b is cos(angle / 2); the clamp guards against rounding.
-  const double w = std::min(1.0, std::abs((a.conjugate() * b).normalized().w()));
-  return 2.0 * std::acos(w) * 180.0 / M_PI;
+  // a^-1 b = (cos(angle / 2), sin(angle / 2) axis); atan2 of the two norms
+  // stays exact near zero, where acos(|w|) loses half the digits.
+  const Eigen::Quaterniond difference = (a.conjugate() * b).normalized();
+  return 2.0 * std::atan2(difference.vec().norm(), std::abs(difference.w())) *
+         180.0 / M_PI;
 }
 
 Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {

@@ -1,0 +1,35 @@
+// Output that appears completely or not at all: files are written to a
+// temporary sibling and renamed into place, so a crash or an error midway
+// never leaves a partial file or folder behind.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rig_calibrator {
+
+// Writes `contents` to `path` through a temporary file in the same folder
+// and a rename (atomic on POSIX file systems).
+bool WriteFileAtomically(const std::string& path, const std::string& contents,
+                         std::string* error);
+
+struct OutputFolderOptions {
+  // Replace an existing non-empty output folder (otherwise that is an error).
+  bool overwrite = false;
+  // Inputs of the run: the output folder may be neither one of them, nor
+  // inside one, nor contain one (overwriting would delete it).
+  std::vector<std::string> input_paths;
+};
+
+// Fills the folder `output_path` through `write_contents`, which gets a fresh
+// temporary sibling folder to write into. Only if it returns true is the
+// temporary folder renamed to `output_path`; otherwise (or on any file system
+// error) the temporary folder is removed and `output_path` is left as it was.
+bool WriteFolderAtomically(
+    const std::string& output_path, const OutputFolderOptions& options,
+    const std::function<bool(const std::string& folder, std::string* error)>&
+        write_contents,
+    std::string* error);
+
+}  // namespace rig_calibrator

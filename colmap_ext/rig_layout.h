@@ -1,0 +1,70 @@
+// Rig discovery from image names: which camera took each image, and which
+// images were taken together (a frameset).
+//
+// Image names are relative to the image path, with '/' (as in a COLMAP
+// database). The cameras are the first-level folders ("cam0/", "cam1/", ...)
+// or user-given prefixes ("rig/cam0/"). An image's frameset key is its name
+// after the camera prefix: identical keys form a frameset (COLMAP's
+// convention: cam0/000012.png and cam1/000012.png), or, when the keys are
+// numbers such as nanosecond timestamps (EuRoC: 1403715273262142976.png),
+// keys within a tolerance do.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace rig_calibrator {
+
+struct RigLayoutOptions {
+  // Image name prefixes of the cameras, e.g. {"rig/cam0/", "rig/cam1/"}; an
+  // image belongs to the longest prefix it starts with. Empty: every
+  // first-level folder of the image names is a camera.
+  std::vector<std::string> camera_prefixes;
+  // 0: a frameset is the images with identical keys. > 0: keys are numbers
+  // (the file name, or the file name without its extension) and images whose
+  // numbers are within this tolerance (in the names' units, e.g. nanoseconds)
+  // form a frameset, at most one image per camera.
+  double timestamp_tolerance = 0;
+};
+
+struct RigLayoutImage {
+  int camera_index = -1;  // -1: the image belongs to no camera (ignored)
+  int frameset_index = -1;
+};
+
+struct RigLayout {
+  // Sorted in natural order (cam2 before cam10). The name is the prefix
+  // without its trailing '/'.
+  std::vector<std::string> camera_names;
+  std::vector<std::string> camera_prefixes;
+  // One per frameset, in natural order of the keys (or by time); the key of
+  // the frameset's earliest image.
+  std::vector<std::string> frameset_names;
+  // One per input image name, in input order.
+  std::vector<RigLayoutImage> images;
+  // Indices of input names that are in no camera (e.g. top-level files).
+  std::vector<int> ignored_images;
+  // Indices of input names alone in their frameset: they constrain their
+  // camera's intrinsics but not the rig.
+  std::vector<int> unmatched_images;
+};
+
+// Discovers the cameras and framesets of `image_names` (the rig images only,
+// not the map's). Fails with a message in `error` when there are no camera
+// folders, fewer than two cameras, a given prefix matches no image, numeric
+// keys are expected but a name is not a number, or some cameras never share
+// a frameset (directly or through other cameras) with the others.
+bool DiscoverRigLayout(const std::vector<std::string>& image_names,
+                       const RigLayoutOptions& options, RigLayout* layout,
+                       std::string* error);
+
+// A table for the log: per camera the number of images, of images in
+// framesets with other cameras and of unmatched images; the number of
+// framesets with k cameras; the first unmatched and ignored names.
+std::string RigLayoutTable(const std::vector<std::string>& image_names,
+                           const RigLayout& layout);
+
+// Natural order: digit runs compare as numbers ("cam2" < "cam10").
+bool NaturalLess(const std::string& a, const std::string& b);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,96 @@
+// Camera upgrade (paper §3.5 "Camera Upgrading and Refinement", MATH.md §3):
+// from a camera's 1D radial pose (R, tx, ty known, tz unknown) and its 2D-3D
+// correspondences, estimate the forward translation tz and all intrinsics of
+// a COLMAP camera model.
+//
+//  1. LO-RANSAC (COLMAP's LORANSAC) with RadialIntrinsicsEstimator
+//     (intrinsics_solvers.h): division-model linear solve for tz, then
+//     variable projection over tz for the target model's radial profile
+//     (polynomial for the perspective models, equidistant for the fisheye
+//     ones) with f and the first two radial terms. Residual: full
+//     reprojection error, principal point fixed at the input estimate.
+//  2. Conversion to the model's parameters: fx = fy = f, k1, k2 where the
+//     model has them, every other distortion term 0.
+//  3. Levenberg-Marquardt (Ceres, Cauchy loss) over tz and all parameters of
+//     the model (the principal point too unless told otherwise) on the full
+//     reprojection error through COLMAP's templated WorldToImage, then the
+//     inliers are re-evaluated on all points; repeated while they change
+//     (at most 3 times).
+//
+// Used for each rig camera with its frames pooled and, for the `rd`
+// baseline, for single images.
+#pragma once
+
+#include <colmap/base/camera.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace rig_calibrator {
+
+struct CameraUpgradeOptions {
+  double max_error_px = 10.0;  // RANSAC inlier threshold on the full
+                               // reprojection error; also the final inliers
+  double confidence = 0.9999;
+  int min_num_trials = 50;
+  int max_num_trials = 2000;
+  // RANSAC runs on a random subset of at most this many correspondences (a
+  // camera pooled over hundreds of frames has 1e5 of them); the inliers are
+  // then evaluated on all of them.
+  int max_num_ransac_points = 10000;
+  double loss_scale_px = 1.0;  // Cauchy scale in the final LM
+  int max_num_iterations = 100;
+  bool refine_principal_point = true;
+  int num_threads = 1;  // of the LM; <= 0: all cores
+};
+
+struct CameraUpgradeResult {
+  double tz = 0;  // forward translation to add to the camera-frame points
+  std::vector<char> inlier_mask;  // per input correspondence
+  int num_inliers = 0;
+  double rms_px = 0;  // full reprojection RMS over the inliers
+
+  // Conditioning of the tz/focal trade-off. With C = (J^T J)^-1, J the
+  // (Cauchy-weighted) Jacobian of the final LM's residuals over tz and every
+  // refined parameter, and f = the mean of the model's focal lengths:
+  //   tz_focal_correlation = C(tz, f) / sqrt(C(tz, tz) C(f, f)),
+  // the correlation of the two estimates. It tends to +-1 when the depths of
+  // the points vary little relative to their distance, since then only
+  // f / (c + tz) is observed. It is +-1 (sign unknown: 1) when J^T J is
+  // numerically singular.
+  double tz_focal_correlation = 0;
+  // False when |tz_focal_correlation| > kMaxWellConditionedCorrelation or
+  // J^T J is numerically singular: f and tz are then poorly determined.
+  bool well_conditioned = true;
+  // One-sigma uncertainties sqrt(C(tz, tz)) rms_px and sqrt(C(f, f)) rms_px,
+  // i.e. at the observed noise level (0 for exact data; also 0 when J^T J is
+  // singular).
+  double tz_stddev = 0;
+  double focal_stddev_px = 0;
+
+  std::string error_message;  // why UpgradeCamera returned false
+};
+
+// |tz_focal_correlation| above which the upgrade is reported as not well
+// conditioned.
+constexpr double kMaxWellConditionedCorrelation = 0.999;
+
+// Whether UpgradeCamera supports the COLMAP camera model: SIMPLE_PINHOLE,
+// PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, SIMPLE_RADIAL_FISHEYE,
+// RADIAL_FISHEYE, OPENCV_FISHEYE, THIN_PRISM_FISHEYE (not FOV).
+bool IsUpgradeSupportedCameraModel(int model_id);
+
+// points2D: pixels (COLMAP convention). points_cam: camera-frame points
+// WITHOUT tz, i.e. R X + (tx, ty, 0), on the correct half-line of the radial
+// pose. camera: in: model_id, width, height, params (principal point = the
+// current estimate, e.g. from the radial BA; other params ignored); out: all
+// params of that model. Correspondences with non-finite values are outliers.
+// Returns false (camera unchanged, result->error_message set and logged) for
+// bad input, an unsupported model or when no consistent model is found.
+bool UpgradeCamera(const CameraUpgradeOptions& options,
+                   const std::vector<Eigen::Vector2d>& points2D,
+                   const std::vector<Eigen::Vector3d>& points_cam,
+                   colmap::Camera* camera, CameraUpgradeResult* result);
+
+}  // namespace rig_calibrator

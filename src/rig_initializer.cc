@@ -1,0 +1,964 @@
+#include "src/rig_initializer.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <colmap/util/threading.h>
+#include <glog/logging.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <utility>
+#include <vector>
+#include <iostream>
+
+#include "src/radial_pose_solver.h"
+
+namespace rig_calibrator {
+namespace {
+
+// Scoring never needs every correspondence: an evenly spread subset of each
+// image's inliers is enough to tell a right rig from a wrong one.
+constexpr int kMaxScoredCorrespondences = 64;
+// An image agrees with a rig hypothesis if its own pose and the rig's pose
+// P_i Q_j each put at least this many of its scored inliers within the
+// truncation, and neither explains less than kMinAgreementRatio of what the
+// other explains. Both poses explaining the same >= 5 correspondences makes
+// them the same radial pose; the ratio (rather than an absolute share) keeps
+// the test meaningful when the principal point is still off.
+constexpr int kMinAgreeingInliers = 5;
+constexpr double kMinAgreementRatio = 0.5;
+// A camera's pose in the rig is the best supported of its per-frameset
+// candidates; an evenly spread subset bounds the quadratic cost.
+constexpr int kMaxCameraCandidates = 50;
+// A kept camera needs this many agreeing images: a wrong per-image pose
+// always agrees with the camera pose made from it.
+constexpr int kMinAgreeingImagesPerCamera = 2;
+
+// A localized image with what the initializer scores it on.
+struct LocalizedImage {
+  int camera = -1;
+  int frameset = -1;
+  Rigid3d cam_from_world;                 // radial: translation.z() = 0
+  std::vector<Eigen::Vector2d> points2D;  // centered, scored inlier subset
+  std::vector<Eigen::Vector3d> points3D;
+  int num_own_inliers = 0;  // scored inliers within the truncation
+};
+
+struct InitProblem {
+  RigInitializerOptions options;
+  int num_cameras = 0;
+  int num_framesets = 0;
+  int reference_camera = 0;
+  int num_rows = 2;  // known rows of each pose: 2 radial, 3 full
+  // Smallest eigenvalue of sum_k (I - z_k z_k^T) over the cameras' axes z_k
+  // that determines a rig translation in eq. 3: 1 - cos(minimum angle).
+  double min_axis_eigenvalue = 0;
+  int num_threads = 1;
+  std::vector<LocalizedImage> images;
+  std::vector<std::vector<int>> images_of_frameset;
+  std::vector<std::vector<int>> images_of_camera;
+};
+
+struct Hypothesis {
+  std::vector<std::optional<Rigid3d>> cam_from_rig;    // P_i
+  std::vector<std::optional<Rigid3d>> rig_from_world;  // Q_j
+};
+
+struct ImageFit {
+  double truncated_sq_sum = 0;  // sum of min(e, tau)^2, pixels^2
+  int num_within = 0;           // e < tau on the correct half-line
+};
+
+ImageFit FitImage(const Rigid3d& cam_from_world, const LocalizedImage& image,
+                  double max_error) {
+  ImageFit fit;
+  for (size_t k = 0; k < image.points2D.size(); ++k) {
+    const double error = RadialReprojectionError(
+        cam_from_world, image.points2D[k], image.points3D[k]);
+    if (error < max_error) {
+      fit.truncated_sq_sum += error * error;
+      ++fit.num_within;
+    } else {
+      fit.truncated_sq_sum += max_error * max_error;
+    }
+  }
+  return fit;
+}
+
+bool Agree(int num_own_inliers, int num_rig_inliers) {
+  const int fewer = std::min(num_own_inliers, num_rig_inliers);
+  const int more = std::max(num_own_inliers, num_rig_inliers);
+  return fewer >= kMinAgreeingInliers && fewer >= kMinAgreementRatio * more;
+}
+
+Eigen::Vector3d PrincipalAxis(const Rigid3d& cam_from_x) {
+  return cam_from_x.RotationMatrix().row(2).transpose();
+}
+
+// sum_k (I - z_k z_k^T): the normal matrix of the translation in eq. 3 with
+// radial poses; singular iff all axes z_k are parallel.
+double SmallestAxisEigenvalue(const std::vector<Eigen::Vector3d>& axes) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& axis : axes) {
+    normal += Eigen::Matrix3d::Identity() - axis * axis.transpose();
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normal,
+                                                        Eigen::EigenvaluesOnly)
+      .eigenvalues()(0);
+}
+
+// P = T Q^-1; the first two rows of P only depend on those of T.
+Rigid3d CamFromRigCandidate(const Rigid3d& cam_from_world,
+                            const Rigid3d& rig_from_world, bool radial) {
+  Rigid3d cam_from_rig = cam_from_world * rig_from_world.Inverse();
+  if (radial) cam_from_rig.translation.z() = 0;
+  return cam_from_rig;
+}
+
+// Eq. 3: the rig pose Q from stacked known rows, [B_k | b_k] = [A_k | a_k] Q
+// with [A_k | a_k] the known rows of P_k and [B_k | b_k] those of T_k.
+// Rotation: Procrustes, argmax_R <sum_k A_k^T B_k, R> over SO(3). Translation:
+// linear least squares, (sum_k A_k^T A_k) t = sum_k A_k^T (b_k - a_k).
+std::optional<Rigid3d> SolveRigFromWorld(
+    const InitProblem& problem,
+    const std::vector<std::pair<const Rigid3d*, const Rigid3d*>>&
+        cam_from_rig_and_cam_from_world) {
+  const int rows = problem.num_rows;
+  Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> axes;
+  for (const auto& [cam_from_rig, cam_from_world] :
+       cam_from_rig_and_cam_from_world) {
+    const Eigen::Matrix3d rig_rotation = cam_from_rig->RotationMatrix();
+    const Eigen::Matrix3d world_rotation = cam_from_world->RotationMatrix();
+    const auto a_rot = rig_rotation.topRows(rows);
+    correlation += a_rot.transpose() * world_rotation.topRows(rows);
+    normal += a_rot.transpose() * a_rot;
+    rhs += a_rot.transpose() * (cam_from_world->translation.head(rows) -
+                                cam_from_rig->translation.head(rows));
+    axes.push_back(rig_rotation.row(2).transpose());
+  }
+  if (axes.empty() || (rows == 2 && SmallestAxisEigenvalue(axes) <
+                                        problem.min_axis_eigenvalue)) {
+    return std::nullopt;
+  }
+  return Rigid3d(NearestRotation(correlation), normal.ldlt().solve(rhs));
+}
+
+// How well a candidate pose explains a set of images: images that agree
+// with it (Agree) first, then the truncated score.
+struct Support {
+  int num_agreeing = 0;
+  double truncated_sq_sum = 0;
+  bool BetterThan(const Support& other) const {
+    return num_agreeing != other.num_agreeing
+               ? num_agreeing > other.num_agreeing
+               : truncated_sq_sum < other.truncated_sq_sum;
+  }
+};
+
+void AddToSupport(const Rigid3d& cam_from_world, const LocalizedImage& image,
+                  double max_error, Support* support) {
+  const ImageFit fit = FitImage(cam_from_world, image, max_error);
+  support->num_agreeing += Agree(image.num_own_inliers, fit.num_within);
+  support->truncated_sq_sum += fit.truncated_sq_sum;
+}
+
+// Q_j of one frameset from the images of its assigned cameras. With more
+// images than needed, the solutions leaving one image out compete with the
+// one using all, so one wrong per-image pose does not spoil the frameset.
+// The winner must be confirmed by its images: at least two must agree with
+// it when radial (one when full), otherwise the frameset stays unassigned
+// (for now: more assigned cameras may confirm it later).
+std::optional<Rigid3d> SolveFramesetRigPose(const InitProblem& problem,
+                                            const Hypothesis& hypothesis,
+                                            int frameset) {
+  std::vector<int> usable;
+  for (const int index : problem.images_of_frameset[frameset]) {
+    if (hypothesis.cam_from_rig[problem.images[index].camera]) {
+      usable.push_back(index);
+    }
+  }
+  const int min_images = problem.num_rows == 2 ? 2 : 1;
+  if (static_cast<int>(usable.size()) < min_images) return std::nullopt;
+
+  std::vector<int> left_out_candidates = {-1};
+  if (static_cast<int>(usable.size()) > min_images) {
+    left_out_candidates.insert(left_out_candidates.end(), usable.begin(),
+                               usable.end());
+  }
+  std::optional<Rigid3d> best;
+  Support best_support;
+  for (const int left_out : left_out_candidates) {
+    std::vector<std::pair<const Rigid3d*, const Rigid3d*>> pairs;
+    for (const int index : usable) {
+      if (index == left_out) continue;
+      const LocalizedImage& image = problem.images[index];
+      pairs.emplace_back(&*hypothesis.cam_from_rig[image.camera],
+                         &image.cam_from_world);
+    }
+    const std::optional<Rigid3d> candidate = SolveRigFromWorld(problem, pairs);
+    if (!candidate) continue;
+    Support support;
+    for (const int index : usable) {
+      const LocalizedImage& image = problem.images[index];
+      AddToSupport(*hypothesis.cam_from_rig[image.camera] * *candidate, image,
+                   problem.options.max_radial_error_px, &support);
+    }
+    if (!best || support.BetterThan(best_support)) {
+      best = candidate;
+      best_support = support;
+    }
+  }
+  if (best_support.num_agreeing < min_images) return std::nullopt;
+  return best;
+}
+
+// Candidate P_i = T_ij Q_j^-1 of camera i from each assigned frameset j that
+// sees it (an evenly spread subset bounds the quadratic cost), with its
+// support among those same images under P_i Q_j.
+struct CameraCandidate {
+  Rigid3d cam_from_rig;
+  Support support;
+};
+
+std::optional<CameraCandidate> BestCamFromRig(const InitProblem& problem,
+                                              const Hypothesis& hypothesis,
+                                              int camera) {
+  std::vector<int> seen;
+  for (const int index : problem.images_of_camera[camera]) {
+    if (hypothesis.rig_from_world[problem.images[index].frameset]) {
+      seen.push_back(index);
+    }
+  }
+  if (seen.empty()) return std::nullopt;
+  if (seen.size() > kMaxCameraCandidates) {
+    std::vector<int> subset;
+    for (int k = 0; k < kMaxCameraCandidates; ++k) {
+      subset.push_back(seen[k * seen.size() / kMaxCameraCandidates]);
+    }
+    seen.swap(subset);
+  }
+  std::optional<CameraCandidate> best;
+  for (const int candidate_index : seen) {
+    const LocalizedImage& candidate_image = problem.images[candidate_index];
+    CameraCandidate candidate;
+    candidate.cam_from_rig = CamFromRigCandidate(
+        candidate_image.cam_from_world,
+        *hypothesis.rig_from_world[candidate_image.frameset],
+        problem.num_rows == 2);
+    for (const int index : seen) {
+      const LocalizedImage& image = problem.images[index];
+      AddToSupport(
+          candidate.cam_from_rig * *hypothesis.rig_from_world[image.frameset],
+          image, problem.options.max_radial_error_px, &candidate.support);
+    }
+    if (!best || candidate.support.BetterThan(best->support)) {
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+// One RANSAC hypothesis: the seed frameset places its cameras relative to a
+// base camera (the rig frame of this hypothesis is the base camera's frame,
+// with its tz = 0 when radial), then rig poses and camera poses are assigned
+// alternately until nothing changes. Cameras confirmed by two of their images
+// are placed before cameras resting on one image, because a wrong per-image
+// pose always agrees with the camera pose made from it.
+Hypothesis AssignGreedily(const InitProblem& problem, int seed_frameset) {
+  Hypothesis hypothesis;
+  hypothesis.cam_from_rig.resize(problem.num_cameras);
+  hypothesis.rig_from_world.resize(problem.num_framesets);
+
+  const std::vector<int>& seed_images =
+      problem.images_of_frameset[seed_frameset];
+  int base = seed_images.front();
+  for (const int index : seed_images) {
+    if (problem.images[index].camera == problem.reference_camera) base = index;
+  }
+  const Rigid3d seed_rig_from_world = problem.images[base].cam_from_world;
+  hypothesis.rig_from_world[seed_frameset] = seed_rig_from_world;
+  for (const int index : seed_images) {
+    const LocalizedImage& image = problem.images[index];
+    hypothesis.cam_from_rig[image.camera] = CamFromRigCandidate(
+        image.cam_from_world, seed_rig_from_world, problem.num_rows == 2);
+  }
+
+  std::vector<std::optional<Rigid3d>> new_rig_poses(problem.num_framesets);
+  std::vector<std::optional<CameraCandidate>> new_cam_poses(
+      problem.num_cameras);
+  while (true) {
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      new_rig_poses[j] = hypothesis.rig_from_world[j]
+                             ? std::nullopt
+                             : SolveFramesetRigPose(problem, hypothesis, j);
+    }
+    bool changed = false;
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      if (new_rig_poses[j]) {
+        hypothesis.rig_from_world[j] = new_rig_poses[j];
+        changed = true;
+      }
+    }
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      new_cam_poses[i] = hypothesis.cam_from_rig[i]
+                             ? std::nullopt
+                             : BestCamFromRig(problem, hypothesis, i);
+    }
+    int best_num_agreeing = 0;
+    for (const std::optional<CameraCandidate>& candidate : new_cam_poses) {
+      if (candidate) {
+        best_num_agreeing =
+            std::max(best_num_agreeing, candidate->support.num_agreeing);
+      }
+    }
+    const int min_agreeing = std::clamp(best_num_agreeing, 1, 2);
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      if (new_cam_poses[i] &&
+          new_cam_poses[i]->support.num_agreeing >= min_agreeing) {
+        hypothesis.cam_from_rig[i] = new_cam_poses[i]->cam_from_rig;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  return hypothesis;
+}
+
+// Per localized image: its fit under the hypothesis, or nullopt if its camera
+// or frameset is unassigned.
+std::vector<std::optional<ImageFit>> FitHypothesis(
+    const InitProblem& problem, const Hypothesis& hypothesis) {
+  std::vector<std::optional<ImageFit>> fits(problem.images.size());
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    const LocalizedImage& image = problem.images[k];
+    if (hypothesis.cam_from_rig[image.camera] &&
+        hypothesis.rig_from_world[image.frameset]) {
+      fits[k] = FitImage(*hypothesis.cam_from_rig[image.camera] *
+                             *hypothesis.rig_from_world[image.frameset],
+                         image, problem.options.max_radial_error_px);
+    }
+  }
+  return fits;
+}
+
+// Sum of min(e, tau)^2 over all scored correspondences; tau^2 for those of
+// images the hypothesis does not cover. Summed in image order, so the result
+// does not depend on the number of threads.
+double TruncatedScore(const InitProblem& problem,
+                      const std::vector<std::optional<ImageFit>>& fits) {
+  const double max_error_sq =
+      problem.options.max_radial_error_px * problem.options.max_radial_error_px;
+  double score = 0;
+  for (size_t k = 0; k < fits.size(); ++k) {
+    score += fits[k] ? fits[k]->truncated_sq_sum
+                     : max_error_sq * problem.images[k].points2D.size();
+  }
+  return score;
+}
+
+std::vector<char> AgreeingImages(
+    const InitProblem& problem,
+    const std::vector<std::optional<ImageFit>>& fits) {
+  std::vector<char> agree(problem.images.size(), 0);
+  for (size_t k = 0; k < fits.size(); ++k) {
+    agree[k] = fits[k] &&
+               Agree(problem.images[k].num_own_inliers, fits[k]->num_within);
+  }
+  return agree;
+}
+
+// Rigid3d <-> (angle-axis, translation) parameter blocks for Ceres.
+std::array<double, 6> ToParameters(const Rigid3d& pose) {
+  std::array<double, 6> parameters;
+  const double quaternion[4] = {pose.rotation.w(), pose.rotation.x(),
+                                pose.rotation.y(), pose.rotation.z()};
+  ceres::QuaternionToAngleAxis(quaternion, parameters.data());
+  for (int r = 0; r < 3; ++r) parameters[3 + r] = pose.translation(r);
+  return parameters;
+}
+
+Rigid3d FromParameters(const std::array<double, 6>& parameters) {
+  double quaternion[4];
+  ceres::AngleAxisToQuaternion(parameters.data(), quaternion);
+  return Rigid3d(Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2],
+                                    quaternion[3]),
+                 Eigen::Vector3d(parameters[3], parameters[4], parameters[5]));
+}
+
+// d(T, P Q) of eq. 4 as a residual vector: the angle-axis vector of
+// R_T^T R_P R_Q (3, radians), then translation_weight * (R_P t_Q + t_P - t_T)
+// over the kRows known rows. Parameters: P and Q as (angle-axis, t).
+template <int kRows>
+class PoseDeviationCost {
+ public:
+  PoseDeviationCost(const Rigid3d& cam_from_world, double translation_weight)
+      : inverse_rotation_{cam_from_world.rotation.w(),
+                          -cam_from_world.rotation.x(),
+                          -cam_from_world.rotation.y(),
+                          -cam_from_world.rotation.z()},
+        translation_(cam_from_world.translation),
+        translation_weight_(translation_weight) {}
+
+  static ceres::CostFunction* Create(const Rigid3d& cam_from_world,
+                                     double translation_weight) {
+    return new ceres::AutoDiffCostFunction<PoseDeviationCost, 3 + kRows, 6, 6>(
+        new PoseDeviationCost(cam_from_world, translation_weight));
+  }
+
+  template <typename T>
+  bool operator()(const T* cam_from_rig, const T* rig_from_world,
+                  T* residuals) const {
+    T cam_quaternion[4], rig_quaternion[4], composed[4], difference[4];
+    ceres::AngleAxisToQuaternion(cam_from_rig, cam_quaternion);
+    ceres::AngleAxisToQuaternion(rig_from_world, rig_quaternion);
+    ceres::QuaternionProduct(cam_quaternion, rig_quaternion, composed);
+    const T inverse_rotation[4] = {
+        T(inverse_rotation_[0]), T(inverse_rotation_[1]),
+        T(inverse_rotation_[2]), T(inverse_rotation_[3])};
+    ceres::QuaternionProduct(inverse_rotation, composed, difference);
+    ceres::QuaternionToAngleAxis(difference, residuals);
+    T translation[3];
+    ceres::AngleAxisRotatePoint(cam_from_rig, rig_from_world + 3, translation);
+    for (int r = 0; r < kRows; ++r) {
+      residuals[3 + r] =
+          T(translation_weight_) *
+          (translation[r] + cam_from_rig[3 + r] - T(translation_(r)));
+    }
+    return true;
+  }
+
+ private:
+  const std::array<double, 4> inverse_rotation_;
+  const Eigen::Vector3d translation_;
+  const double translation_weight_;
+};
+
+// Local optimization of eq. 4 over the hypothesis' kept cameras and rig poses
+// with the agreeing images as observations. The reference camera's pose is
+// held at the identity; with radial poses each camera's tz is held at 0 and
+// the slide of the rig origin along the reference axis (see the header) is
+// held by one rig pose's t_z.
+void MinimizePoseDeviation(const InitProblem& problem,
+                           const std::vector<char>& used,
+                           Hypothesis* hypothesis) {
+  const bool radial = problem.num_rows == 2;
+  std::vector<std::array<double, 6>> cam_parameters(problem.num_cameras);
+  std::vector<std::array<double, 6>> rig_parameters(problem.num_framesets);
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (hypothesis->cam_from_rig[i]) {
+      cam_parameters[i] = ToParameters(*hypothesis->cam_from_rig[i]);
+    }
+  }
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (hypothesis->rig_from_world[j]) {
+      rig_parameters[j] = ToParameters(*hypothesis->rig_from_world[j]);
+    }
+  }
+
+  ceres::Problem ceres_problem;
+  ceres::LossFunction* loss = new ceres::CauchyLoss(problem.options.loss_scale);
+  std::vector<char> cam_added(problem.num_cameras, 0);
+  std::vector<char> rig_added(problem.num_framesets, 0);
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    if (!used[k]) continue;
+    const LocalizedImage& image = problem.images[k];
+    ceres::CostFunction* cost =
+        radial ? PoseDeviationCost<2>::Create(
+                     image.cam_from_world, problem.options.translation_weight)
+               : PoseDeviationCost<3>::Create(
+                     image.cam_from_world, problem.options.translation_weight);
+    ceres_problem.AddResidualBlock(cost, loss,
+                                   cam_parameters[image.camera].data(),
+                                   rig_parameters[image.frameset].data());
+    cam_added[image.camera] = 1;
+    rig_added[image.frameset] = 1;
+  }
+  if (ceres_problem.NumResidualBlocks() == 0) return;
+
+  auto* ordering = new ceres::ParameterBlockOrdering;
+  bool tz_gauge_held = false;
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (!rig_added[j]) continue;
+    ordering->AddElementToGroup(rig_parameters[j].data(), 0);
+    if (radial && !tz_gauge_held) {
+      ceres_problem.SetManifold(rig_parameters[j].data(),
+                                new ceres::SubsetManifold(6, {5}));
+      tz_gauge_held = true;
+    }
+  }
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (!cam_added[i]) continue;
+    ordering->AddElementToGroup(cam_parameters[i].data(), 1);
+    if (i == problem.reference_camera) {
+      ceres_problem.SetParameterBlockConstant(cam_parameters[i].data());
+    } else if (radial) {
+      ceres_problem.SetManifold(cam_parameters[i].data(),
+                                new ceres::SubsetManifold(6, {5}));
+    }
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering.reset(ordering);
+  solver_options.max_num_iterations = 100;
+  solver_options.num_threads = problem.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(solver_options, &ceres_problem, &solver_summary);
+  if (!solver_summary.IsSolutionUsable()) {
+    LOG(WARNING) << "InitializeRig: the refinement of eq. 4 failed ("
+                 << solver_summary.message << "); keeping the RANSAC rig";
+    return;
+  }
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (cam_added[i]) {
+      hypothesis->cam_from_rig[i] = FromParameters(cam_parameters[i]);
+    }
+  }
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (rig_added[j]) {
+      hypothesis->rig_from_world[j] = FromParameters(rig_parameters[j]);
+    }
+  }
+}
+
+// Re-expresses a hypothesis in the reference camera's frame (with its tz = 0
+// when radial): Q_j <- P_ref Q_j, P_i <- P_i P_ref^-1.
+void ExpressInReferenceFrame(const InitProblem& problem,
+                             Hypothesis* hypothesis) {
+  const Rigid3d ref_from_rig =
+      *hypothesis->cam_from_rig[problem.reference_camera];
+  const Rigid3d rig_from_ref = ref_from_rig.Inverse();
+  for (std::optional<Rigid3d>& cam_from_rig : hypothesis->cam_from_rig) {
+    if (!cam_from_rig) continue;
+    *cam_from_rig = *cam_from_rig * rig_from_ref;
+    if (problem.num_rows == 2) cam_from_rig->translation.z() = 0;
+  }
+  hypothesis->cam_from_rig[problem.reference_camera] = Rigid3d();
+  for (std::optional<Rigid3d>& rig_from_world : hypothesis->rig_from_world) {
+    if (rig_from_world) *rig_from_world = ref_from_rig * *rig_from_world;
+  }
+}
+
+// Which images, cameras and rig poses the final rig keeps: images that agree
+// with the hypothesis, framesets they determine (radial: two of them with
+// non-parallel axes), cameras with two such images in kept framesets;
+// repeated until stable because dropping a camera can undetermine a
+// frameset. Unkept cameras and framesets are unassigned in the hypothesis.
+std::vector<char> KeepDeterminedParts(const InitProblem& problem,
+                                      const std::vector<char>& agree,
+                                      Hypothesis* hypothesis) {
+  std::vector<char> used = agree;
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    std::vector<char> kept_frameset(problem.num_framesets, 0);
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      std::vector<Eigen::Vector3d> axes;
+      for (const int index : problem.images_of_frameset[j]) {
+        if (used[index]) {
+          axes.push_back(PrincipalAxis(
+              *hypothesis->cam_from_rig[problem.images[index].camera]));
+        }
+      }
+      kept_frameset[j] =
+          problem.num_rows == 2
+              ? axes.size() >= 2 &&
+                    SmallestAxisEigenvalue(axes) >= problem.min_axis_eigenvalue
+              : !axes.empty();
+    }
+    std::vector<int> num_camera_images(problem.num_cameras, 0);
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      if (used[k] && kept_frameset[problem.images[k].frameset]) {
+        ++num_camera_images[problem.images[k].camera];
+      }
+    }
+    std::vector<char> kept_camera(problem.num_cameras, 0);
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      kept_camera[i] = num_camera_images[i] >= kMinAgreeingImagesPerCamera;
+    }
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      const LocalizedImage& image = problem.images[k];
+      if (used[k] &&
+          !(kept_frameset[image.frameset] && kept_camera[image.camera])) {
+        used[k] = 0;
+        changed = true;
+      }
+    }
+    if (!changed) {
+      for (int j = 0; j < problem.num_framesets; ++j) {
+        if (!kept_frameset[j]) hypothesis->rig_from_world[j].reset();
+      }
+      for (int i = 0; i < problem.num_cameras; ++i) {
+        if (!kept_camera[i]) hypothesis->cam_from_rig[i].reset();
+      }
+    }
+  }
+  return used;
+}
+
+bool Fail(const std::string& message, RigInitializerSummary* summary) {
+  LOG(ERROR) << "InitializeRig: " << message;
+  if (summary) summary->message = message;
+  return false;
+}
+
+// Validates the input and gathers the localized images. Returns an error
+// message, empty on success.
+std::string BuildProblem(const RigInitializerOptions& options,
+                         const RigDataset& dataset,
+                         const RigCalibration& calibration,
+                         InitProblem* problem) {
+  problem->options = options;
+  problem->num_cameras = dataset.cameras.size();
+  problem->num_framesets = dataset.frameset_names.size();
+  problem->reference_camera = dataset.reference_camera;
+  problem->num_rows = options.radial ? 2 : 3;
+  problem->min_axis_eigenvalue =
+      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
+  problem->num_threads = colmap::GetEffectiveNumThreads(options.num_threads);
+  problem->images_of_frameset.assign(problem->num_framesets, {});
+  problem->images_of_camera.assign(problem->num_cameras, {});
+
+  std::ostringstream error;
+  if (problem->num_cameras == 0) return "the dataset has no cameras";
+  if (dataset.reference_camera < 0 ||
+      dataset.reference_camera >= problem->num_cameras) {
+    error << "reference camera index " << dataset.reference_camera
+          << " is not one of the " << problem->num_cameras << " cameras";
+    return error.str();
+  }
+  if (!(options.max_radial_error_px > 0) || !(options.loss_scale > 0) ||
+      !(options.translation_weight >= 0) || !(options.confidence > 0) ||
+      !(options.confidence < 1) || options.max_num_trials < 1) {
+    return "invalid options: max_radial_error_px and loss_scale must be "
+           "positive, translation_weight non-negative, confidence in (0, 1), "
+           "max_num_trials >= 1";
+  }
+  if (calibration.images.size() != dataset.images.size()) {
+    error << "calibration has " << calibration.images.size()
+          << " image results for " << dataset.images.size() << " images";
+    return error.str();
+  }
+  for (const RigCamera& camera : dataset.cameras) {
+    if (!camera.camera.VerifyParams()) {
+      return "camera " + camera.name + " has no valid model parameters";
+    }
+  }
+
+  std::map<std::pair<int, int>, int> image_of_slot;
+  for (size_t k = 0; k < dataset.images.size(); ++k) {
+    const RigImage& rig_image = dataset.images[k];
+    const ImageResult& result = calibration.images[k];
+    if (rig_image.camera_index < 0 ||
+        rig_image.camera_index >= problem->num_cameras ||
+        rig_image.frameset_index < 0 ||
+        rig_image.frameset_index >= problem->num_framesets) {
+      error << "image " << rig_image.name << " has camera index "
+            << rig_image.camera_index << " and frameset index "
+            << rig_image.frameset_index << ", out of range";
+      return error.str();
+    }
+    if (!result.inlier_mask.empty() &&
+        result.inlier_mask.size() != rig_image.correspondences.size()) {
+      error << "image " << rig_image.name << " has an inlier mask of size "
+            << result.inlier_mask.size() << " for "
+            << rig_image.correspondences.size() << " correspondences";
+      return error.str();
+    }
+    if (!result.single_image_cam_from_world) continue;
+    const auto [slot, inserted] = image_of_slot.emplace(
+        std::make_pair(rig_image.camera_index, rig_image.frameset_index), k);
+    if (!inserted) {
+      error << "images " << dataset.images[slot->second].name << " and "
+            << rig_image.name << " are both localized images of camera "
+            << dataset.cameras[rig_image.camera_index].name << " in frameset "
+            << rig_image.frameset_index;
+      return error.str();
+    }
+
+    LocalizedImage image;
+    image.camera = rig_image.camera_index;
+    image.frameset = rig_image.frameset_index;
+    image.cam_from_world = *result.single_image_cam_from_world;
+    if (!image.cam_from_world.rotation.coeffs().allFinite() ||
+        !image.cam_from_world.translation.head(problem->num_rows).allFinite()) {
+      return "image " + rig_image.name + " has a non-finite pose";
+    }
+    if (options.radial) image.cam_from_world.translation.z() = 0;
+
+    std::vector<int> inliers;
+    for (size_t c = 0; c < result.inlier_mask.size(); ++c) {
+      if (result.inlier_mask[c]) inliers.push_back(c);
+    }
+    const int num_scored =
+        std::min<int>(inliers.size(), kMaxScoredCorrespondences);
+    const colmap::Camera& camera =
+        dataset.cameras[rig_image.camera_index].camera;
+    const Eigen::Vector2d principal_point(camera.PrincipalPointX(),
+                                          camera.PrincipalPointY());
+    for (int s = 0; s < num_scored; ++s) {
+      const Correspondence& correspondence =
+          rig_image.correspondences[inliers[s * inliers.size() / num_scored]];
+      image.points2D.push_back(correspondence.point2D - principal_point);
+      image.points3D.push_back(correspondence.point3D);
+    }
+    image.num_own_inliers =
+        FitImage(image.cam_from_world, image, options.max_radial_error_px)
+            .num_within;
+    problem->images_of_frameset[image.frameset].push_back(
+        problem->images.size());
+    problem->images_of_camera[image.camera].push_back(problem->images.size());
+    problem->images.push_back(std::move(image));
+  }
+  return "";
+}
+
+}  // namespace
+
+bool InitializeRig(const RigInitializerOptions& options,
+                   const RigDataset& dataset, RigCalibration* calibration,
+                   RigInitializerSummary* summary) {
+  if (summary) *summary = RigInitializerSummary();
+  if (calibration == nullptr) return Fail("no calibration given", summary);
+  InitProblem problem;
+  const std::string error =
+      BuildProblem(options, dataset, *calibration, &problem);
+  if (!error.empty()) return Fail(error, summary);
+  if (summary) summary->num_images_localized = problem.images.size();
+
+  if (options.radial) {
+    std::string explanation;
+    if (PrincipalAxesAreParallel(dataset, *calibration,
+                                 options.min_principal_axis_angle_deg,
+                                 &explanation)) {
+      return Fail(explanation +
+                      "; 1D radial poses cannot determine the rig poses of "
+                      "a rig with parallel principal axes: use full "
+                      "per-image poses (the rd_ra method)",
+                  summary);
+    }
+  }
+
+  std::vector<int> seeds;
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (problem.images_of_frameset[j].size() >= 2) seeds.push_back(j);
+  }
+  if (seeds.empty()) {
+    return Fail("no frameset has two localized images", summary);
+  }
+  std::mt19937 random_engine(options.seed);
+  std::shuffle(seeds.begin(), seeds.end(), random_engine);
+
+  // RANSAC over seed framesets. A seed is good if all its localized images
+  // agree with the best hypothesis; with a share w of good seeds, the
+  // probability that k trials all miss one is (1 - w)^k.
+  Hypothesis best;
+  double best_score = std::numeric_limits<double>::infinity();
+  int num_trials = 0;
+  double required_trials = std::numeric_limits<double>::infinity();
+  const int max_trials =
+      std::min<int>(options.max_num_trials, static_cast<int>(seeds.size()));
+  while (num_trials < max_trials && num_trials < required_trials) {
+    Hypothesis hypothesis = AssignGreedily(problem, seeds[num_trials]);
+    ++num_trials;
+    const std::vector<std::optional<ImageFit>> fits =
+        FitHypothesis(problem, hypothesis);
+    const double score = TruncatedScore(problem, fits);
+    if (getenv("RIGDEBUG")) {
+      int nc = 0, nf = 0;
+      for (auto& c : hypothesis.cam_from_rig) nc += c.has_value();
+      for (auto& c : hypothesis.rig_from_world) nf += c.has_value();
+      std::cerr << "TRIAL seed " << seeds[num_trials - 1] << " cams " << nc << " framesets " << nf << " score " << score << std::endl;
+    }
+    if (score >= best_score) continue;
+    best = std::move(hypothesis);
+    best_score = score;
+    const std::vector<char> agree = AgreeingImages(problem, fits);
+    int num_good_seeds = 0;
+    for (const int seed : seeds) {
+      bool good = true;
+      for (const int index : problem.images_of_frameset[seed]) {
+        good = good && agree[index];
+      }
+      num_good_seeds += good;
+    }
+    const double good_share =
+        static_cast<double>(num_good_seeds) / seeds.size();
+    if (good_share >= 1) {
+      required_trials = 1;
+    } else if (good_share > 0) {
+      required_trials = std::ceil(std::log(1 - options.confidence) /
+                                  std::log(1 - good_share));
+    }
+  }
+
+  int num_scored = 0;
+  for (const LocalizedImage& image : problem.images) {
+    num_scored += image.points2D.size();
+  }
+  if (summary) {
+    summary->num_trials = num_trials;
+    summary->best_score =
+        num_scored > 0 ? std::sqrt(best_score / num_scored) : 0;
+  }
+
+  const std::string reference_name =
+      dataset.cameras[problem.reference_camera].name;
+  const int num_reference_images =
+      problem.images_of_camera[problem.reference_camera].size();
+  if (!best.cam_from_rig[problem.reference_camera]) {
+    std::ostringstream message;
+    message << "the reference camera " << reference_name
+            << " could not be placed in the rig (" << num_reference_images
+            << " of its images localized); choose another reference camera";
+    return Fail(message.str(), summary);
+  }
+  ExpressInReferenceFrame(problem, &best);
+  const std::vector<char> used = KeepDeterminedParts(
+      problem, AgreeingImages(problem, FitHypothesis(problem, best)), &best);
+  if (!best.cam_from_rig[problem.reference_camera]) {
+    std::ostringstream message;
+    message << "none of the " << num_reference_images
+            << " localized images of the reference camera " << reference_name
+            << " agrees with the best rig hypothesis; choose another "
+               "reference camera";
+    return Fail(message.str(), summary);
+  }
+  MinimizePoseDeviation(problem, used, &best);
+
+  calibration->cam_from_rig.assign(problem.num_cameras, Rigid3d());
+  calibration->camera_calibrated.assign(problem.num_cameras, false);
+  calibration->rig_from_world.assign(problem.num_framesets, std::nullopt);
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (best.cam_from_rig[i]) {
+      calibration->cam_from_rig[i] = *best.cam_from_rig[i];
+      calibration->camera_calibrated[i] = true;
+    }
+  }
+  calibration->cam_from_rig[problem.reference_camera] = Rigid3d();
+  calibration->rig_from_world = best.rig_from_world;
+  if (options.radial) {
+    NormalizeRadialRigOrigin(problem.reference_camera, calibration);
+  }
+
+  if (summary) {
+    summary->num_cameras_assigned =
+        std::count(calibration->camera_calibrated.begin(),
+                   calibration->camera_calibrated.end(), true);
+    summary->num_framesets_assigned = std::count_if(
+        calibration->rig_from_world.begin(), calibration->rig_from_world.end(),
+        [](const std::optional<Rigid3d>& pose) { return pose.has_value(); });
+    summary->num_images_consistent = std::count(used.begin(), used.end(), 1);
+  }
+  return true;
+}
+
+bool PrincipalAxesAreParallel(const RigDataset& dataset,
+                              const RigCalibration& calibration,
+                              double max_angle_deg, std::string* explanation) {
+  // Per frameset, the world principal axes of its localized images.
+  std::map<int, std::vector<std::pair<int, Eigen::Vector3d>>> axes_of_frameset;
+  const size_t num_images =
+      std::min(dataset.images.size(), calibration.images.size());
+  for (size_t k = 0; k < num_images; ++k) {
+    const std::optional<Rigid3d>& pose =
+        calibration.images[k].single_image_cam_from_world;
+    if (!pose || !pose->rotation.coeffs().allFinite()) continue;
+    axes_of_frameset[dataset.images[k].frameset_index].emplace_back(
+        dataset.images[k].camera_index, PrincipalAxis(*pose));
+  }
+  std::map<std::pair<int, int>, std::vector<double>> angles_of_pair;
+  for (const auto& [frameset, axes] : axes_of_frameset) {
+    for (size_t a = 0; a < axes.size(); ++a) {
+      for (size_t b = a + 1; b < axes.size(); ++b) {
+        if (axes[a].first == axes[b].first) continue;
+        const double cosine =
+            std::clamp(axes[a].second.dot(axes[b].second), -1.0, 1.0);
+        angles_of_pair[std::minmax(axes[a].first, axes[b].first)].push_back(
+            std::acos(cosine) * 180.0 / M_PI);
+      }
+    }
+  }
+
+  auto camera_name = [&](int index) {
+    return index >= 0 && index < static_cast<int>(dataset.cameras.size())
+               ? dataset.cameras[index].name
+               : "#" + std::to_string(index);
+  };
+  std::ostringstream message;
+  if (angles_of_pair.empty()) {
+    message << "no frameset has two localized images of different cameras: "
+               "the principal axes cannot be compared";
+    if (explanation) *explanation = message.str();
+    return false;
+  }
+  double widest_angle = -1;
+  std::pair<int, int> widest_pair;
+  int widest_count = 0;
+  for (auto& [pair, angles] : angles_of_pair) {
+    std::nth_element(angles.begin(), angles.begin() + angles.size() / 2,
+                     angles.end());
+    const double median = angles[angles.size() / 2];
+    if (median > widest_angle) {
+      widest_angle = median;
+      widest_pair = pair;
+      widest_count = angles.size();
+    }
+  }
+  const bool parallel = widest_angle <= max_angle_deg;
+  if (parallel) {
+    message << "all principal axes are within " << max_angle_deg
+            << " degrees of parallel";
+  } else {
+    message << "the principal axes are not parallel";
+  }
+  message << " (largest median angle " << widest_angle << " degrees, between "
+          << camera_name(widest_pair.first) << " and "
+          << camera_name(widest_pair.second) << " over " << widest_count
+          << " framesets)";
+  if (explanation) *explanation = message.str();
+  return parallel;
+}
+
+void NormalizeRadialRigOrigin(int reference_camera,
+                              RigCalibration* calibration) {
+  double numerator = 0;
+  double denominator = 0;
+  for (size_t i = 0; i < calibration->cam_from_rig.size(); ++i) {
+    if (static_cast<int>(i) == reference_camera ||
+        i >= calibration->camera_calibrated.size() ||
+        !calibration->camera_calibrated[i]) {
+      continue;
+    }
+    const Rigid3d& cam_from_rig = calibration->cam_from_rig[i];
+    const Eigen::Vector2d axis_xy =
+        cam_from_rig.RotationMatrix().col(2).head<2>();
+    numerator += axis_xy.dot(cam_from_rig.translation.head<2>());
+    denominator += axis_xy.squaredNorm();
+  }
+  // All parallel: the slide is undetermined and changes nothing.
+  const double slide = denominator > 1e-12 ? -numerator / denominator : 0.0;
+  for (Rigid3d& cam_from_rig : calibration->cam_from_rig) {
+    cam_from_rig.translation += slide * cam_from_rig.RotationMatrix().col(2);
+    cam_from_rig.translation.z() = 0;
+  }
+  for (std::optional<Rigid3d>& rig_from_world : calibration->rig_from_world) {
+    if (rig_from_world) rig_from_world->translation.z() -= slide;
+  }
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,135 @@
+// Robust initialization of the rig (paper §3.3): the camera-from-rig poses
+// P_i and the rig-from-world poses Q_j from the per-image poses T_ij, which
+// should satisfy T_ij = P_i Q_j for every localized image (camera i,
+// frameset j).
+//
+// With 1D radial poses only the first two rows of T_ij are known, so only the
+// first two rows of P_i are sought (paper eq. 3-4). A RANSAC over seed
+// framesets makes hypotheses by greedy back-and-forth assignment; the one
+// with the lowest robust radial reprojection error over all images wins and
+// is refined by minimizing eq. 4,
+//   min_{P_i, Q_j} sum_{(i,j)} rho(d(T_ij, P_i Q_j)),
+// with a Cauchy loss rho.
+//
+// Gauge of radial rigs (MATH.md §4). A radial camera's position along its own
+// principal axis is unobservable, and that includes the reference camera:
+// the rig origin can slide by d along the reference camera's axis, which
+// changes no radial projection but changes every other camera's (tx, ty) by
+// d (R_i e_z)_xy. The radial stages therefore store tz = 0 for every camera
+// and fix d with NormalizeRadialRigOrigin below; the reference camera's
+// cam_from_rig is the identity in that sense (its tz is unknown). Once the
+// forward translations are estimated (upgrade, MATH.md §3), including the
+// reference camera's, re-expressing everything in the reference camera's
+// frame (Q_j <- P_ref Q_j, P_i <- P_i P_ref^-1) makes the rig metric.
+#pragma once
+
+#include <string>
+
+#include "src/rig_dataset.h"
+
+namespace rig_calibrator {
+
+struct RigInitializerOptions {
+  // True: only the first two rows of each per-image pose are known (1D radial
+  // poses, tz unknown; the `1dr` method). False: full 6-DoF poses (`rd_ra`,
+  // `known*` methods).
+  bool radial = true;
+  // RANSAC over seed framesets. A seed frameset determines its hypothesis, so
+  // at most one trial per seed frameset is made; trials also stop once the
+  // share of seeds consistent with the best hypothesis makes another seed
+  // unlikely to do better (at `confidence`).
+  int max_num_trials = 500;
+  double confidence = 0.999;
+  // Truncation of the robust radial reprojection score, pixels.
+  double max_radial_error_px = 8.0;
+  // Cauchy scale of the local optimization of eq. 4, in the units of
+  // d(T, P Q): rotation difference in radians, plus translation_weight times
+  // the translation difference in map units (first two rows when radial).
+  double loss_scale = 1.0;
+  // Radians per map unit: weight of the translation difference against the
+  // rotation difference in d(T, P Q).
+  double translation_weight = 1.0;
+  // Radial rigs: two cameras whose principal axes are closer to parallel
+  // than this do not determine a rig pose's translation (eq. 3).
+  double min_principal_axis_angle_deg = 5.0;
+  int num_threads = -1;
+  unsigned int seed = 0;
+};
+
+struct RigInitializerSummary {
+  int num_trials = 0;
+  // Truncated radial RMS of the best hypothesis, pixels: the square root of
+  // the mean of min(e, max_radial_error_px)^2 over the scored inlier
+  // correspondences of all localized images (images of unassigned cameras or
+  // framesets count max_radial_error_px).
+  double best_score = 0;
+  int num_cameras_assigned = 0;
+  int num_framesets_assigned = 0;
+  // Localized images whose pose and correspondences agree with the rig; the
+  // observations of eq. 4.
+  int num_images_consistent = 0;
+  int num_images_localized = 0;
+  // Why InitializeRig failed; empty on success.
+  std::string message;
+};
+
+// Input: dataset (cameras with the principal point in camera.params, images
+// with correspondences) and, per dataset image, calibration->images[i]:
+// single_image_cam_from_world (unset = not localized; with `radial`, its
+// translation.z() is ignored) and inlier_mask (that image's RANSAC inliers,
+// one entry per correspondence; empty = no inliers).
+// Output: calibration->cam_from_rig (one per camera; the reference camera's
+// is the identity; with `radial`, tz = 0 for all cameras and the rig origin
+// is fixed by NormalizeRadialRigOrigin), calibration->rig_from_world (per
+// frameset; nullopt where it could not be determined from consistent
+// images) and calibration->camera_calibrated (false for cameras that could
+// not be placed; their cam_from_rig is the identity).
+//
+// Per trial: a random seed frameset with >= 2 localized images gives the P_i
+// of its cameras relative to one of them. Then, alternately, the Q_j of
+// framesets with assigned cameras are solved (Procrustes on the stacked known
+// rows, least squares for the translation; radial rigs need two cameras with
+// non-parallel axes; with more images than needed the leave-one-out
+// solutions compete) and kept if two of the frameset's images agree with
+// them (one for full poses), and unassigned P_i = T_ij Q_j^-1 are taken from
+// the frameset whose candidate most of camera i's images agree with, cameras
+// confirmed by two images first. An image agrees with a pose if both its own
+// pose and that pose put >= 5 of its scored inliers within
+// max_radial_error_px and neither explains less than half of what the other
+// does. The best hypothesis by radial score keeps its agreeing images, the
+// framesets they determine and the cameras with two of them; eq. 4 is
+// minimized over those.
+//
+// Returns false (message in summary->message and the log) on inconsistent
+// input, on radial rigs with parallel principal axes, or if the reference
+// camera cannot be placed. Deterministic for a given seed. summary may be
+// null.
+bool InitializeRig(const RigInitializerOptions& options,
+                   const RigDataset& dataset, RigCalibration* calibration,
+                   RigInitializerSummary* summary);
+
+// Parallel-axes diagnosis (paper Limitations, MATH.md §4). From the
+// per-image poses calibration.images[i].single_image_cam_from_world: for
+// every pair of cameras, the median over the framesets where both are
+// localized of the angle between their principal axes (third rows of the
+// rotations). Returns true if every pair's median is at most max_angle_deg,
+// i.e. a radial rig cannot be fixed (use full per-image poses, `rd_ra`).
+// Returns false if some pair is farther from parallel, and also if no
+// frameset has two localized images (nothing to judge); `explanation` (may be
+// null) says which.
+bool PrincipalAxesAreParallel(const RigDataset& dataset,
+                              const RigCalibration& calibration,
+                              double max_angle_deg, std::string* explanation);
+
+// Fixes the gauge of a radial rig (see the top of this file): moves the rig
+// origin along the reference camera's principal axis to the point closest,
+// in least squares, to the principal axes of the other calibrated cameras,
+//   d = -sum_i g_i . t_i,xy / sum_i |g_i|^2,  g_i = (R_i e_z)_xy,
+// then t_i,xy += d g_i, every rig_from_world translation -= d e_z, and tz = 0
+// for all cameras. |t_i,xy| is the distance of the rig origin from camera i's
+// axis. The radial projections do not change. Does nothing to the
+// translations if all calibrated cameras are parallel to the reference.
+void NormalizeRadialRigOrigin(int reference_camera,
+                              RigCalibration* calibration);
+
+}  // namespace rig_calibrator
