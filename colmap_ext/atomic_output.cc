@@ -102,9 +102,8 @@ bool WriteFolderAtomically(
     if (input_path.empty()) continue;
     const fs::path input = Normalized(input_path);
     if (IsWithin(output, input) || IsWithin(input, output)) {
-      *error = "the output path " + output_path +
-               " overlaps the input path " + input_path +
-               "; choose an output folder outside the inputs";
+      *error = "the output path " + output_path + " overlaps the input path " +
+               input_path + "; choose an output folder outside the inputs";
       return false;
     }
   }
@@ -113,8 +112,7 @@ bool WriteFolderAtomically(
   const bool output_exists = fs::exists(output, code);
   if (output_exists) {
     if (!fs::is_directory(output, code)) {
-      *error = "the output path " + output_path +
-               " exists and is not a folder";
+      *error = "the output path " + output_path + " exists and is not a folder";
       return false;
     }
     if (!fs::is_empty(output, code) && !options.overwrite) {

@@ -1,5 +1,7 @@
 // `rig_calibrator benchmark`: the paper's experiments on synthetic rigs.
 // Writes Markdown tables to the terminal and, with --output_path, to a file.
+#include <glog/logging.h>
+
 #include <boost/program_options.hpp>
 #include <iostream>
 
@@ -37,8 +39,8 @@ int RunBenchmark(int argc, char** argv) {
       "missing_image_ratio",
       po::value(&options.recording.missing_image_ratio)
           ->default_value(options.recording.missing_image_ratio),
-      "share of images dropped")(
-      "seed", po::value(&seed)->default_value(seed), "random seed")(
+      "share of images dropped")("seed", po::value(&seed)->default_value(seed),
+                                 "random seed")(
       "output_path", po::value(&output_path),
       "also write the table (Markdown) to this file");
   int exit_code = EXIT_SUCCESS;
@@ -52,6 +54,8 @@ int RunBenchmark(int argc, char** argv) {
     std::cerr << "ERROR: unknown preset " << preset << std::endl;
     return EXIT_FAILURE;
   }
+  // Hundreds of calibrations: keep their per-stage log lines off the table.
+  FLAGS_minloglevel = google::GLOG_WARNING;
   options.seed = static_cast<unsigned int>(seed);
   options.recording.seed = static_cast<unsigned int>(seed);
   std::string error;

@@ -66,9 +66,9 @@ po::options_description Describe(CalibrateOptions* o) {
   description.add_options()("help,h", "show this help")(
       "database_path", po::value(&o->database_path),
       "COLMAP 3.8 database with the map images and the rig images' features "
-      "(never modified)")(
-      "image_path", po::value(&o->image_path),
-      "folder of the rig images, one sub-folder per camera (cam0/, cam1/, ...)")(
+      "(never modified)")("image_path", po::value(&o->image_path),
+                          "folder of the rig images, one sub-folder per camera "
+                          "(cam0/, cam1/, ...)")(
       "input_path", po::value(&o->input_path),
       "the map: a COLMAP sparse model folder (binary or text)")(
       "output_path", po::value(&o->output_path),
@@ -280,9 +280,9 @@ bool MakeDataset(const CalibrateOptions& options,
   dataset->frameset_names = layout->frameset_names;
   dataset->reference_camera = 0;
   if (!options.reference_camera.empty()) {
-    const auto it = std::find(layout->camera_names.begin(),
-                              layout->camera_names.end(),
-                              options.reference_camera);
+    const auto it =
+        std::find(layout->camera_names.begin(), layout->camera_names.end(),
+                  options.reference_camera);
     if (it == layout->camera_names.end()) {
       *error = "--RigCalibrator.reference_camera " + options.reference_camera +
                " is not a camera of the rig";
@@ -384,9 +384,10 @@ bool LoadFromDatabase(const CalibrateOptions& options,
   for (const colmap::image_t image_id : map.RegImageIds()) {
     const std::string& name = map.Image(image_id).Name();
     if (std::binary_search(image_names.begin(), image_names.end(), name)) {
-      *error = "image " + name +
-               " is both a rig image and a registered map image: keep the rig "
-               "images out of the map, or give --image_path the rig images only";
+      *error =
+          "image " + name +
+          " is both a rig image and a registered map image: keep the rig "
+          "images out of the map, or give --image_path the rig images only";
       return false;
     }
   }
@@ -542,8 +543,10 @@ int RunCalibrate(int argc, char** argv) {
   }
   PipelineOptions pipeline;
   if (!CalibrationMethodFromName(options.method, &pipeline.method)) {
-    Fail("--RigCalibrator.method must be one of 1dr, rd_ra, rd, known, "
-         "known_refine, not " + options.method);
+    Fail(
+        "--RigCalibrator.method must be one of 1dr, rd_ra, rd, known, "
+        "known_refine, not " +
+        options.method);
     return EXIT_FAILURE;
   }
 
@@ -554,8 +557,8 @@ int RunCalibrate(int argc, char** argv) {
       Fail(error);
       return EXIT_FAILURE;
     }
-    std::cout << "  " << map.NumRegImages() << " images, "
-              << map.NumPoints3D() << " points" << std::endl;
+    std::cout << "  " << map.NumRegImages() << " images, " << map.NumPoints3D()
+              << " points" << std::endl;
   }
 
   RigDataset dataset;

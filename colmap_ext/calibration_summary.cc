@@ -30,8 +30,8 @@ CalibrationSummary SummarizeCalibration(
     camera.name = rig.cameras[c].name;
     camera.image_prefix = rig.cameras[c].image_prefix;
     camera.calibrated = calibration.camera_calibrated[c];
-    camera.camera = camera.calibrated ? calibration.cameras[c]
-                                      : dataset.cameras[c].camera;
+    camera.camera =
+        camera.calibrated ? calibration.cameras[c] : dataset.cameras[c].camera;
     camera.cam_from_rig = rig.cameras[c].cam_from_rig;
   }
   for (size_t i = 0; i < dataset.images.size(); ++i) {
@@ -43,8 +43,8 @@ CalibrationSummary SummarizeCalibration(
     if (!result.used) continue;
     ++camera.num_used;
     camera.num_inliers += result.num_inliers;
-    radial_sum[c] += result.num_inliers * result.radial_rms_px *
-                     result.radial_rms_px;
+    radial_sum[c] +=
+        result.num_inliers * result.radial_rms_px * result.radial_rms_px;
     full_sum[c] += result.num_inliers * result.rms_px * result.rms_px;
   }
   for (size_t c = 0; c < summary.cameras.size(); ++c) {
@@ -114,7 +114,9 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     timings[stage] = number(seconds);
   }
   root["timings_s"] = timings;
-  return WriteFileAtomically(path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n", error);
+  return WriteFileAtomically(
+      path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
+      error);
 }
 
 }  // namespace rig_calibrator

@@ -18,6 +18,14 @@ namespace {
 // COLMAP's at (0.5, 0.5).
 constexpr double kKalibrPixelShift = 0.5;
 
+// (f_x, f_y); models with one focal length have f_x = f_y.
+Eigen::Vector2d FocalLengths(const colmap::Camera& camera) {
+  if (camera.FocalLengthIdxs().size() == 1) {
+    return Eigen::Vector2d::Constant(camera.FocalLength());
+  }
+  return Eigen::Vector2d(camera.FocalLengthX(), camera.FocalLengthY());
+}
+
 // The normalized distorted point d = u + D(coeffs; u) of Kalibr's radtan
 // (fisheye = false) or equidistant (fisheye = true) model at the undistorted
 // normalized point u. COLMAP's OPENCV and OPENCV_FISHEYE distortion functions
@@ -48,8 +56,8 @@ bool FitKalibrDistortion(const colmap::Camera& camera, bool fisheye,
                          std::string* error) {
   constexpr int kGridX = 32;
   constexpr int kGridY = 24;
-  const double fx = camera.FocalLengthX();
-  const double fy = camera.FocalLengthY();
+  const double fx = FocalLengths(camera).x();
+  const double fy = FocalLengths(camera).y();
   const double cx = camera.PrincipalPointX();
   const double cy = camera.PrincipalPointY();
   std::vector<Eigen::Vector2d> undistorted;
@@ -95,8 +103,7 @@ bool FitKalibrDistortion(const colmap::Camera& camera, bool fisheye,
   const Eigen::VectorXd residuals = a * k - b;
   *max_error_px = 0;
   for (int i = 0; i < n; ++i) {
-    *max_error_px =
-        std::max(*max_error_px, residuals.segment<2>(2 * i).norm());
+    *max_error_px = std::max(*max_error_px, residuals.segment<2>(2 * i).norm());
   }
   if (!k.allFinite()) {
     *error = "the Kalibr distortion fit of the " + camera.ModelName() +
@@ -160,7 +167,7 @@ bool ColmapToKalibrCamera(const colmap::Camera& camera, KalibrCamera* kalibr,
   const std::vector<double>& p = camera.Params();
   kalibr->width = static_cast<int>(camera.Width());
   kalibr->height = static_cast<int>(camera.Height());
-  kalibr->intrinsics = {camera.FocalLengthX(), camera.FocalLengthY(),
+  kalibr->intrinsics = {FocalLengths(camera).x(), FocalLengths(camera).y(),
                         camera.PrincipalPointX() - kKalibrPixelShift,
                         camera.PrincipalPointY() - kKalibrPixelShift};
   const std::string model = camera.ModelName();
@@ -203,10 +210,9 @@ bool ColmapToKalibrCamera(const colmap::Camera& camera, KalibrCamera* kalibr,
     return false;
   }
   if (!kalibr->exact) {
-    return FitKalibrDistortion(camera,
-                               kalibr->distortion_model == "equidistant",
-                               &kalibr->distortion_coeffs,
-                               &kalibr->max_fit_error_px, error);
+    return FitKalibrDistortion(
+        camera, kalibr->distortion_model == "equidistant",
+        &kalibr->distortion_coeffs, &kalibr->max_fit_error_px, error);
   }
   return true;
 }
@@ -245,8 +251,8 @@ bool KalibrToColmapCamera(const KalibrCamera& kalibr, colmap::Camera* camera,
     model = "PINHOLE";
     params = {k[0], k[1], cx, cy};
   } else {
-    *error = "unsupported Kalibr distortion model '" +
-             kalibr.distortion_model + "' with " + std::to_string(d.size()) +
+    *error = "unsupported Kalibr distortion model '" + kalibr.distortion_model +
+             "' with " + std::to_string(d.size()) +
              " coefficients (radtan 4, equidistant 4, fov 1, none 0)";
     return false;
   }
@@ -292,8 +298,8 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
     } else {
       const std::string note =
           "camchain.yaml: " + key + " (" + camera.name + ") approximates " +
-          camera.camera->ModelName() + " by Kalibr " +
-          kalibr.distortion_model + " (least-squares fit, max error " +
+          camera.camera->ModelName() + " by Kalibr " + kalibr.distortion_model +
+          " (least-squares fit, max error " +
           FormatDouble(std::round(kalibr.max_fit_error_px * 1e4) / 1e4) +
           " px over the image)";
       yaml << ", approximated: " << kalibr.distortion_model
@@ -318,8 +324,7 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
          << "  distortion_model: " << kalibr.distortion_model << "\n"
          << "  distortion_coeffs: " << YamlList(kalibr.distortion_coeffs)
          << "\n"
-         << "  resolution: [" << kalibr.width << ", " << kalibr.height
-         << "]\n"
+         << "  resolution: [" << kalibr.width << ", " << kalibr.height << "]\n"
          << "  rostopic: " << TopicPlaceholder(camera.name) << "\n";
     previous_cam_from_rig = &*camera.cam_from_rig;
     ++index;

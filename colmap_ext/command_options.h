@@ -11,9 +11,9 @@ namespace rig_calibrator {
 // command should run. Returns false, with *exit_code set, after printing the
 // help (`-h`, `--help`: success) or a parse error naming the option
 // (failure).
-bool ParseCommandLine(int argc, char** argv,
-                      const boost::program_options::options_description&
-                          description,
-                      const std::string& title, int* exit_code);
+bool ParseCommandLine(
+    int argc, char** argv,
+    const boost::program_options::options_description& description,
+    const std::string& title, int* exit_code);
 
 }  // namespace rig_calibrator

@@ -57,9 +57,10 @@ bool ParseImageLine(std::string_view line, const LineError& fail,
   if (!ParseInt64(tokens[n - 3], &width) ||
       !ParseInt64(tokens[n - 2], &height) ||
       !ParseInt64(tokens[n - 1], num_rows)) {
-    return fail("expected integers <width> <height> <num_rows> after the "
-                "image name",
-                error);
+    return fail(
+        "expected integers <width> <height> <num_rows> after the "
+        "image name",
+        error);
   }
   if (width <= 0 || height <= 0 || width > INT32_MAX || height > INT32_MAX) {
     return fail("the image size must be positive", error);
@@ -68,9 +69,10 @@ bool ParseImageLine(std::string_view line, const LineError& fail,
     return fail("num_rows must be >= 0", error);
   }
   const size_t name_begin = tokens[1].data() - line.data();
-  const size_t name_end = tokens[n - 4].data() + tokens[n - 4].size() -
-                          line.data();
-  image->image_name = std::string(line.substr(name_begin, name_end - name_begin));
+  const size_t name_end =
+      tokens[n - 4].data() + tokens[n - 4].size() - line.data();
+  image->image_name =
+      std::string(line.substr(name_begin, name_end - name_begin));
   image->width = static_cast<int>(width);
   image->height = static_cast<int>(height);
   return true;
@@ -216,8 +218,8 @@ bool WriteCorrespondenceFile(const std::string& path,
       *error = "the image " + name + " has no size";
       return false;
     }
-    text << "IMAGE " << name << " " << image.width << " " << image.height
-         << " " << image.correspondences.size() << "\n";
+    text << "IMAGE " << name << " " << image.width << " " << image.height << " "
+         << image.correspondences.size() << "\n";
     for (const Correspondence& c : image.correspondences) {
       if (!c.point2D.allFinite() || !c.point3D.allFinite()) {
         *error = "the image " + name + " has a non-finite correspondence";
@@ -225,8 +227,7 @@ bool WriteCorrespondenceFile(const std::string& path,
       }
       text << FormatDouble(c.point2D.x()) << " " << FormatDouble(c.point2D.y())
            << " " << FormatDouble(c.point3D.x()) << " "
-           << FormatDouble(c.point3D.y()) << " "
-           << FormatDouble(c.point3D.z());
+           << FormatDouble(c.point3D.y()) << " " << FormatDouble(c.point3D.z());
       if (c.point3D_id >= 0) {
         text << " " << c.point3D_id;
       }

@@ -338,6 +338,12 @@ bool DatabaseReader::ReadCamera(const colmap::camera_t camera_id,
   return true;
 }
 
+std::string DatabaseReader::ImageLabel(const colmap::image_t image_id) const {
+  const DatabaseImage* image = FindImageWithId(image_id);
+  return "image " + (image != nullptr ? image->name + " (id " : "(id ") +
+         std::to_string(image_id) + ")";
+}
+
 int DatabaseReader::CountRows(sqlite3_stmt* statement,
                               const colmap::image_t image_id) const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -362,7 +368,7 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
   StatementScope scope(read_keypoints_);
   sqlite3_bind_int64(read_keypoints_, 1, image_id);
   const std::string what =
-      "database " + path_ + ": keypoints of image " + std::to_string(image_id);
+      "database " + path_ + ": keypoints of " + ImageLabel(image_id);
   if (sqlite3_step(read_keypoints_) != SQLITE_ROW) {
     *error = what + " are missing (run `colmap feature_extractor` on it)";
     return false;
@@ -400,8 +406,8 @@ bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
   std::lock_guard<std::mutex> lock(mutex_);
   StatementScope scope(read_descriptors_);
   sqlite3_bind_int64(read_descriptors_, 1, image_id);
-  const std::string what = "database " + path_ + ": descriptors of image " +
-                           std::to_string(image_id);
+  const std::string what =
+      "database " + path_ + ": descriptors of " + ImageLabel(image_id);
   if (sqlite3_step(read_descriptors_) != SQLITE_ROW) {
     *error = what + " are missing (run `colmap feature_extractor` on it)";
     return false;
@@ -445,8 +451,8 @@ bool DatabaseReader::ReadInlierMatches(const colmap::image_t image_id1,
   if (rows <= 0) return true;
   if (cols != 2 ||
       num_bytes != rows * cols * static_cast<int64_t>(sizeof(uint32_t))) {
-    *error = "database " + path_ + ": inlier matches of images " +
-             std::to_string(image_id1) + " and " + std::to_string(image_id2) +
+    *error = "database " + path_ + ": inlier matches of " +
+             ImageLabel(image_id1) + " and " + ImageLabel(image_id2) +
              " are malformed";
     return false;
   }

@@ -95,6 +95,8 @@ class DatabaseReader {
   bool CheckSchema(std::string* error);
   bool ReadImages(std::string* error);
   int CountRows(sqlite3_stmt* statement, colmap::image_t image_id) const;
+  // "image <name> (id <id>)" for messages.
+  std::string ImageLabel(colmap::image_t image_id) const;
 
   std::string path_;
   sqlite3* database_ = nullptr;

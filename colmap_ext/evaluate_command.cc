@@ -68,8 +68,9 @@ bool MatchCameras(const RigDescription& reference,
     names->push_back(ref.name);
   }
   if (names->empty()) {
-    *error = "the calibration and the reference have no camera in common "
-             "(cameras are matched by name, i.e. image prefix)";
+    *error =
+        "the calibration and the reference have no camera in common "
+        "(cameras are matched by name, i.e. image prefix)";
     return false;
   }
   return true;
@@ -83,9 +84,9 @@ int RunEvaluate(int argc, char** argv) {
   description.add_options()("help,h", "show this help")(
       "reference_path", po::value(&options.reference_path)->required(),
       "reference calibration: rig_calibrator output folder, rig_config.json "
-      "or camchain.yaml")(
-      "calibration_path", po::value(&options.calibration_path)->required(),
-      "calibration to evaluate, in the same formats")(
+      "or camchain.yaml")("calibration_path",
+                          po::value(&options.calibration_path)->required(),
+                          "calibration to evaluate, in the same formats")(
       "output_path", po::value(&options.output_path),
       "write the errors as JSON to this file")(
       "align_scale", po::value(&options.align_scale)->default_value(false),

@@ -283,9 +283,16 @@ bool MapLocalizer::ReadMap(const colmap::Reconstruction& map,
   std::vector<int> num_rows(point3D_ids.size(), 0);
   for (const auto& [image_id, image_point3D_ids] : map_image_point3D_ids_) {
     for (const colmap::point3D_t point3D_id : image_point3D_ids) {
-      if (point3D_id != colmap::kInvalidPoint3DId) {
-        ++num_rows[point_index_of.at(point3D_id)];
+      if (point3D_id == colmap::kInvalidPoint3DId) continue;
+      const auto it = point_index_of.find(point3D_id);
+      if (it == point_index_of.end()) {
+        *error = "the map is inconsistent: map image " +
+                 database_->FindImageWithId(image_id)->name +
+                 " observes point " + std::to_string(point3D_id) +
+                 ", which is not in its points3D";
+        return false;
       }
+      ++num_rows[it->second];
     }
   }
   std::vector<int> first_row(point3D_ids.size() + 1, 0);

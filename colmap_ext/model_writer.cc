@@ -120,7 +120,8 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
   rig = ModelRig();
   rig.reference_camera = dataset.reference_camera;
   for (size_t c = 0; c < num_cameras; ++c) {
-    cameras[c].SetCameraId(max_camera_id + 1 + static_cast<colmap::camera_t>(c));
+    cameras[c].SetCameraId(max_camera_id + 1 +
+                           static_cast<colmap::camera_t>(c));
     model.AddCamera(cameras[c]);
     rig.camera_ids.push_back(cameras[c].CameraId());
     if (!calibration.camera_calibrated[c]) {
@@ -144,8 +145,8 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
       continue;
     }
     if (map_names.count(rig_image.name) > 0) {
-      *error = "the rig image " + rig_image.name +
-               " has the name of a map image";
+      *error =
+          "the rig image " + rig_image.name + " has the name of a map image";
       return false;
     }
     if (frame_of_frameset[f] < 0) {
@@ -181,7 +182,8 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
       const colmap::point3D_t id = static_cast<colmap::point3D_t>(point3D_id);
       if (model.ExistsPoint3D(id) && observed.insert(id).second) {
         model.AddObservation(
-            id, colmap::TrackElement(image_id, static_cast<colmap::point2D_t>(k)));
+            id,
+            colmap::TrackElement(image_id, static_cast<colmap::point2D_t>(k)));
       }
     }
   }
@@ -189,7 +191,8 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
 }
 
 bool WriteRigOutput(const std::string& output_path,
-                    const colmap::Reconstruction& map, const RigDataset& dataset,
+                    const colmap::Reconstruction& map,
+                    const RigDataset& dataset,
                     const RigCalibration& calibration,
                     const std::vector<std::string>& camera_prefixes,
                     const CalibrationSummary& summary,
@@ -249,9 +252,9 @@ bool WriteRigOutput(const std::string& output_path,
           std::to_string(num_multi_image_frames) + " such framesets");
     }
     for (const std::string& problem : grouping.problems) {
-      new_notes.push_back(std::string(kRigBundleAdjusterConfigFile) +
-                          ": COLMAP 3.8 rig_bundle_adjuster would abort: " +
-                          problem);
+      new_notes.push_back(
+          std::string(kRigBundleAdjusterConfigFile) +
+          ": COLMAP 3.8 rig_bundle_adjuster would abort: " + problem);
     }
   } else {
     new_notes.push_back(std::string(kRigBundleAdjusterConfigFile) +

@@ -70,7 +70,8 @@ struct RigOutputOptions {
 // cameras, what COLMAP's rig tools will make of the configs) are appended to
 // the summary's diagnostics in the file and to `notes` (may be null).
 bool WriteRigOutput(const std::string& output_path,
-                    const colmap::Reconstruction& map, const RigDataset& dataset,
+                    const colmap::Reconstruction& map,
+                    const RigDataset& dataset,
                     const RigCalibration& calibration,
                     const std::vector<std::string>& camera_prefixes,
                     const CalibrationSummary& summary,

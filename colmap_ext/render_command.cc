@@ -149,6 +149,12 @@ bool WriteGroundTruth(const RenderedDatasetOptions& options,
     return false;
   }
 
+  // In the form of rig_calibrator's --RigCalibrator.camera_model.
+  std::string camera_models;
+  for (int c = 0; c < num_cameras; ++c) {
+    camera_models += (c > 0 ? "," : "") + plan.rig.camera_names[c] + ":" +
+                     plan.rig.cameras[c].ModelName();
+  }
   std::ostringstream summary;
   summary << "scene " << SceneTypeName(options.scene) << "\n"
           << "preset " << RigPresetName(options.preset) << "\n"
@@ -156,6 +162,7 @@ bool WriteGroundTruth(const RenderedDatasetOptions& options,
           << "num_map_images " << plan.map_image_names.size() << "\n"
           << "num_framesets " << plan.frameset_names.size() << "\n"
           << "num_rig_cameras " << num_cameras << "\n"
+          << "camera_models " << camera_models << "\n"
           << "supersampling " << render_options.supersampling << "\n"
           << "noise_stddev " << render_options.noise_stddev << "\n"
           << "units meters, world z up\n";
@@ -294,7 +301,7 @@ int RunRender(int argc, char** argv) {
       "supersampling",
       po::value<int>(&render_options.supersampling)
           ->default_value(render_options.supersampling),
-      "samples per pixel along each axis")(
+      "samples per pixel along each axis at silhouettes and face boundaries")(
       "noise_stddev",
       po::value<double>(&render_options.noise_stddev)
           ->default_value(render_options.noise_stddev),

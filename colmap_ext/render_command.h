@@ -17,7 +17,10 @@
 //                                   rig_configurator format)
 //     rig_from_world.txt            "FRAMESET QW QX QY QZ TX TY TZ" per
 //                                   frameset
-//     dataset.txt                   the options used and the counts
+//     dataset.txt                   the options used, the counts and
+//                                   "camera_models cam0:OPENCV,..." (the
+//                                   true models, as
+//                                   --RigCalibrator.camera_model takes them)
 #pragma once
 
 #include <string>

@@ -128,8 +128,8 @@ bool ReadRigCamera(const Json& node, const std::string& where,
   const bool has_model = node.contains("camera_model_name");
   const bool has_params = node.contains("camera_params");
   if (has_model != has_params) {
-    *error = where +
-             ": camera_model_name and camera_params must be given together";
+    *error =
+        where + ": camera_model_name and camera_params must be given together";
     return false;
   }
   if (has_model) {
@@ -149,11 +149,11 @@ bool ReadRigCamera(const Json& node, const std::string& where,
     }
     intrinsics.SetParams(params);
     if (!intrinsics.VerifyParams()) {
-      *error = where + ": " + intrinsics.ModelName() + " takes " +
-               std::to_string(colmap::CameraModelNumParams(
-                   intrinsics.ModelId())) +
-               " camera_params (" + intrinsics.ParamsInfo() + "), not " +
-               std::to_string(params.size());
+      *error =
+          where + ": " + intrinsics.ModelName() + " takes " +
+          std::to_string(colmap::CameraModelNumParams(intrinsics.ModelId())) +
+          " camera_params (" + intrinsics.ParamsInfo() + "), not " +
+          std::to_string(params.size());
       return false;
     }
     camera->camera = intrinsics;
@@ -188,7 +188,9 @@ bool WriteRigConfigJson(const std::string& path, const RigDescription& rig,
     cameras.push_back(node);
   }
   Json rigs = Json::array({Json{{"cameras", cameras}}});
-  return WriteFileAtomically(path, rigs.dump(2, ' ', false, Json::error_handler_t::replace) + "\n", error);
+  return WriteFileAtomically(
+      path, rigs.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
+      error);
 }
 
 bool ReadRigConfigJson(const std::string& path,
@@ -255,10 +257,10 @@ bool WriteRigBundleAdjusterConfig(const std::string& path,
   const RigDescriptionCamera& reference = rig.cameras[rig.reference_camera];
   if (!reference.camera || !reference.cam_from_rig ||
       reference.camera->CameraId() == colmap::kInvalidCameraId) {
-    *error =
-        "the reference camera " + reference.name +
-        " is not calibrated or has no camera id: COLMAP 3.8 rig_bundle_adjuster "
-        "needs it";
+    *error = "the reference camera " + reference.name +
+             " is not calibrated or has no camera id: COLMAP 3.8 "
+             "rig_bundle_adjuster "
+             "needs it";
     return false;
   }
   Json cameras = Json::array();
@@ -277,8 +279,12 @@ bool WriteRigBundleAdjusterConfig(const std::string& path,
   Json rig_node;
   rig_node["ref_camera_id"] = reference.camera->CameraId();
   rig_node["cameras"] = cameras;
-  return WriteFileAtomically(path, Json::array({rig_node}).dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
-                             error);
+  return WriteFileAtomically(
+      path,
+      Json::array({rig_node})
+              .dump(2, ' ', false, Json::error_handler_t::replace) +
+          "\n",
+      error);
 }
 
 RigBundleAdjusterGrouping PredictRigBundleAdjusterGrouping(

@@ -16,8 +16,9 @@ bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
   const size_t num_framesets = dataset.frameset_names.size();
   if (num_cameras == 0 || dataset.reference_camera < 0 ||
       dataset.reference_camera >= static_cast<int>(num_cameras)) {
-    *error = "the dataset has no cameras or its reference camera is out of "
-             "range";
+    *error =
+        "the dataset has no cameras or its reference camera is out of "
+        "range";
     return false;
   }
   if (calibration.cameras.size() != num_cameras ||
@@ -85,10 +86,9 @@ RigDescription DescribeCalibratedRig(
         image_prefixes.empty() ? camera.name + "/" : image_prefixes[c];
     if (calibration.camera_calibrated[c]) {
       camera.camera = calibration.cameras[c];
-      camera.cam_from_rig =
-          static_cast<int>(c) == dataset.reference_camera
-              ? Rigid3d()
-              : calibration.cam_from_rig[c] * rig_from_ref;
+      camera.cam_from_rig = static_cast<int>(c) == dataset.reference_camera
+                                ? Rigid3d()
+                                : calibration.cam_from_rig[c] * rig_from_ref;
     }
     rig.cameras.push_back(std::move(camera));
   }

@@ -45,7 +45,8 @@ bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
 // (ref_from_rig)^-1 (the identity for the reference camera whatever rounding
 // the solver left). Cameras with camera_calibrated false have neither
 // intrinsics nor cam_from_rig. `image_prefixes` (one per camera) may be empty:
-// the prefix is then the camera's name followed by '/'.
+// the prefix is then the camera's name followed by '/'. Requires
+// CheckCalibrationMatchesDataset.
 RigDescription DescribeCalibratedRig(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);

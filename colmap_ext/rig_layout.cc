@@ -289,8 +289,8 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
     std::sort(folders.begin(), folders.end(), NaturalLess);
     for (const std::string& folder : folders) {
       for (std::vector<int>& cluster :
-           ClusterTimestamps(folder_images[folder], timed_keys,
-                             layout->images, options.timestamp_tolerance)) {
+           ClusterTimestamps(folder_images[folder], timed_keys, layout->images,
+                             options.timestamp_tolerance)) {
         framesets.push_back(std::move(cluster));
       }
     }
@@ -360,8 +360,8 @@ std::string RigLayoutTable(const std::vector<std::string>& image_names,
   table << "Rig layout: " << num_cameras << " cameras, "
         << layout.frameset_names.size() << " framesets\n";
   auto pad = [](const std::string& text, size_t width) {
-    return text + std::string(width > text.size() ? width - text.size() : 0,
-                              ' ');
+    return text +
+           std::string(width > text.size() ? width - text.size() : 0, ' ');
   };
   auto right = [](const std::string& text, size_t width) {
     return std::string(width > text.size() ? width - text.size() : 0, ' ') +

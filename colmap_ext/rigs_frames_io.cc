@@ -310,8 +310,9 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
   if (num_rig_cameras == 0 || rig.reference_camera < 0 ||
       rig.reference_camera >= num_rig_cameras ||
       static_cast<int>(rig.cam_from_rig.size()) != num_rig_cameras) {
-    *error = "the rig has no cameras, or its reference camera or poses do "
-             "not match its cameras";
+    *error =
+        "the rig has no cameras, or its reference camera or poses do "
+        "not match its cameras";
     return false;
   }
   std::unordered_map<colmap::camera_t, int> rig_camera_index;
@@ -354,8 +355,7 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
   }
   ColmapRig calibrated;
   calibrated.rig_id = max_camera_id + 1;
-  calibrated.ref_sensor = {kSensorCamera,
-                           rig.camera_ids[rig.reference_camera]};
+  calibrated.ref_sensor = {kSensorCamera, rig.camera_ids[rig.reference_camera]};
   for (int c = 0; c < num_rig_cameras; ++c) {
     if (c == rig.reference_camera) continue;
     calibrated.sensors.push_back(
@@ -399,8 +399,7 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
       const Rigid3d expected =
           *rig.cam_from_rig[camera->second] * rig_frame.rig_from_world;
       const Rigid3d stored = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
-      if ((expected.RotationMatrix() - stored.RotationMatrix()).norm() >
-              1e-9 ||
+      if ((expected.RotationMatrix() - stored.RotationMatrix()).norm() > 1e-9 ||
           (expected.translation - stored.translation).norm() >
               1e-9 * std::max(1.0, expected.translation.norm())) {
         *error = "the pose of the image " + image.Name() +
@@ -429,8 +428,7 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
     ColmapFrame trivial;
     trivial.frame_id = image_id;
     trivial.rig_id = image.CameraId();
-    trivial.rig_from_world =
-        Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
+    trivial.rig_from_world = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
     trivial.data.push_back({{kSensorCamera, image.CameraId()}, image_id});
     rigs_frames->frames.push_back(std::move(trivial));
   }
@@ -476,8 +474,7 @@ bool WriteRigsAndFrames(const std::string& folder,
       AppendBinary<uint32_t>(frame.frame_id, &frames);
       AppendBinary<uint32_t>(frame.rig_id, &frames);
       AppendPoseBinary(frame.rig_from_world, &frames);
-      AppendBinary<uint32_t>(static_cast<uint32_t>(frame.data.size()),
-                             &frames);
+      AppendBinary<uint32_t>(static_cast<uint32_t>(frame.data.size()), &frames);
       for (const ColmapFrameData& data : frame.data) {
         AppendBinary<int32_t>(data.sensor.type, &frames);
         AppendBinary<uint32_t>(data.sensor.id, &frames);
@@ -521,8 +518,8 @@ bool WriteRigsAndFrames(const std::string& folder,
     WritePoseText(frame.rig_from_world, &frames);
     frames << " " << frame.data.size();
     for (const ColmapFrameData& data : frame.data) {
-      frames << " " << SensorTypeName(data.sensor.type) << " "
-             << data.sensor.id << " " << data.data_id;
+      frames << " " << SensorTypeName(data.sensor.type) << " " << data.sensor.id
+             << " " << data.data_id;
     }
     frames << "\n";
   }

@@ -11,7 +11,8 @@
 // frame.
 //
 // rigs.txt, one line per rig (single spaces, 17 significant digits):
-//   RIG_ID NUM_SENSORS REF_TYPE REF_ID (TYPE ID HAS_POSE [QW QX QY QZ TX TY TZ])*
+//   RIG_ID NUM_SENSORS REF_TYPE REF_ID (TYPE ID HAS_POSE [QW QX QY QZ TX TY
+//   TZ])*
 // frames.txt, one line per frame:
 //   FRAME_ID RIG_ID QW QX QY QZ TX TY TZ NUM_DATA (TYPE SENSOR_ID DATA_ID)*
 // rigs.bin (little endian): u64 num_rigs, per rig u32 rig_id, u32 num_sensors,

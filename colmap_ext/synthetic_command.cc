@@ -60,9 +60,11 @@ int RunSynthetic(int argc, char** argv) {
       po::value(&options.missing_image_ratio)
           ->default_value(options.missing_image_ratio),
       "share of images dropped")(
-      "min_depth", po::value(&options.min_depth)->default_value(options.min_depth),
+      "min_depth",
+      po::value(&options.min_depth)->default_value(options.min_depth),
       "nearest map points (map units)")(
-      "max_depth", po::value(&options.max_depth)->default_value(options.max_depth),
+      "max_depth",
+      po::value(&options.max_depth)->default_value(options.max_depth),
       "farthest map points (map units)")(
       "seed", po::value(&seed)->default_value(seed), "random seed")(
       "overwrite", po::value(&overwrite)->default_value(false),
@@ -116,13 +118,14 @@ int RunSynthetic(int argc, char** argv) {
   }
   std::cout << "Wrote " << rig.dataset.images.size() << " images of "
             << rig.truth.cameras.size() << " cameras in "
-            << rig.dataset.frameset_names.size() << " framesets ("
-            << preset << ") to " << output_path
+            << rig.dataset.frameset_names.size() << " framesets (" << preset
+            << ") to " << output_path
             << "\nCalibrate with:\n  rig_calibrator --correspondences_path "
             << output_path << "/correspondences.txt --output_path OUT "
             << "--RigCalibrator.camera_model " << models
             << "\nEvaluate with:\n  rig_calibrator evaluate --reference_path "
-            << output_path << "/ground_truth/camchain.yaml --calibration_path OUT"
+            << output_path
+            << "/ground_truth/camchain.yaml --calibration_path OUT"
             << std::endl;
   return EXIT_SUCCESS;
 }

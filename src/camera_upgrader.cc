@@ -168,10 +168,11 @@ class FullReprojectionCost {
   const Eigen::Vector3d point_cam_;
 };
 
+// Entries of C = (J^T J)^-1 (variances at 1 px noise); see
+// CameraUpgradeResult.
 struct Conditioning {
-  double tz_focal_correlation = 1;
   bool singular = true;
-  // Variances at unit pixel noise.
+  double tz_focal_correlation = 1;
   double tz_variance = 0;
   double focal_variance = 0;
 };
@@ -242,8 +243,11 @@ Conditioning ComputeConditioning(const ceres::Problem& problem,
   return conditioning;
 }
 
-// Marks the points whose full reprojection error is below the threshold;
-// returns their number.
+// Marks the points whose full reprojection error is below the threshold and
+// that the model projects on the side of the principal point given by the
+// radial pose, (x - c).(a, b) >= 0 (a distortion whose radial factor turns
+// negative mirrors points through the principal point); returns their
+// number.
 template <typename CameraModel>
 int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
                     const std::vector<Eigen::Vector3d>& points_cam,
@@ -252,6 +256,9 @@ int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
                     const double max_error_px, std::vector<char>* inlier_mask,
                     double* rms_px) {
   const double max_squared_error = max_error_px * max_error_px;
+  const Eigen::Vector2d principal_point(
+      params[CameraModel::principal_point_idxs[0]],
+      params[CameraModel::principal_point_idxs[1]]);
   inlier_mask->assign(points2D.size(), 0);
   int num_inliers = 0;
   double sum_squared_error = 0;
@@ -265,7 +272,8 @@ int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
                               points_cam[i].y() / depth, &projection.x(),
                               &projection.y());
     const double squared_error = (projection - points2D[i]).squaredNorm();
-    if (squared_error <= max_squared_error) {
+    if (squared_error <= max_squared_error &&
+        (projection - principal_point).dot(points_cam[i].head<2>()) >= 0) {
       (*inlier_mask)[i] = 1;
       ++num_inliers;
       sum_squared_error += squared_error;
@@ -305,8 +313,8 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
   solver_options.max_num_iterations = options.max_num_iterations;
   solver_options.num_threads =
       colmap::GetEffectiveNumThreads(options.num_threads);
-  solver_options.function_tolerance = 1e-12;
-  solver_options.gradient_tolerance = 1e-14;
+  // Noisy data stop on the cost (Ceres' default function tolerance); exact
+  // data, whose cost keeps falling by orders of magnitude, on the step.
   solver_options.parameter_tolerance = 1e-12;
   solver_options.logging_type = ceres::SILENT;
 
@@ -359,13 +367,25 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
     if (inlier_mask == previous_mask || round + 1 == kMaxNumRefinementRounds) {
       const Conditioning conditioning = ComputeConditioning(
           problem, residual_blocks, focal_tangent_idxs, num_tangent_params);
+      double mean_focal = 0;
+      for (const size_t i : focal_idxs) {
+        mean_focal += refined_params[i] / focal_idxs.size();
+      }
+      std::vector<double> depths;
+      for (size_t i = 0; i < points_cam.size(); ++i) {
+        if (inlier_mask[i]) depths.push_back(points_cam[i].z() + refined_tz);
+      }
+      std::nth_element(depths.begin(), depths.begin() + depths.size() / 2,
+                       depths.end());
+      const double median_depth =
+          depths.empty() ? 0 : depths[depths.size() / 2];
       result->tz_focal_correlation = conditioning.tz_focal_correlation;
-      result->well_conditioned = !conditioning.singular &&
-                                 std::abs(conditioning.tz_focal_correlation) <=
-                                     kMaxWellConditionedCorrelation;
-      result->tz_stddev = std::sqrt(conditioning.tz_variance) * result->rms_px;
-      result->focal_stddev_px =
-          std::sqrt(conditioning.focal_variance) * result->rms_px;
+      result->tz_stddev_at_1px = std::sqrt(conditioning.tz_variance);
+      result->focal_stddev_at_1px = std::sqrt(conditioning.focal_variance);
+      result->well_conditioned =
+          !conditioning.singular &&
+          result->focal_stddev_at_1px <= kMaxRelativeStddevAt1px * mean_focal &&
+          result->tz_stddev_at_1px <= kMaxRelativeStddevAt1px * median_depth;
       break;
     }
   }

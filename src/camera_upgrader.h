@@ -51,30 +51,32 @@ struct CameraUpgradeResult {
   int num_inliers = 0;
   double rms_px = 0;  // full reprojection RMS over the inliers
 
-  // Conditioning of the tz/focal trade-off. With C = (J^T J)^-1, J the
-  // (Cauchy-weighted) Jacobian of the final LM's residuals over tz and every
-  // refined parameter, and f = the mean of the model's focal lengths:
-  //   tz_focal_correlation = C(tz, f) / sqrt(C(tz, tz) C(f, f)),
-  // the correlation of the two estimates. It tends to +-1 when the depths of
-  // the points vary little relative to their distance, since then only
-  // f / (c + tz) is observed. It is +-1 (sign unknown: 1) when J^T J is
+  // Conditioning of the tz/focal trade-off (MATH.md §3 pitfalls). With
+  // C = (J^T J)^-1, J the (Cauchy-weighted) Jacobian of the final LM's
+  // residuals in pixels over tz and every refined parameter, and f the mean
+  // of the model's focal lengths:
+  //   tz_focal_correlation = C(tz, f) / sqrt(C(tz, tz) C(f, f)).
+  // It tends to 1 when the depths of the points vary little relative to
+  // their distance, since then only f / (c + tz) is observed; 1 when J^T J is
   // numerically singular.
   double tz_focal_correlation = 0;
-  // False when |tz_focal_correlation| > kMaxWellConditionedCorrelation or
-  // J^T J is numerically singular: f and tz are then poorly determined.
-  bool well_conditioned = true;
-  // One-sigma uncertainties sqrt(C(tz, tz)) rms_px and sqrt(C(f, f)) rms_px,
-  // i.e. at the observed noise level (0 for exact data; also 0 when J^T J is
-  // singular).
-  double tz_stddev = 0;
-  double focal_stddev_px = 0;
+  // One-sigma uncertainties sqrt(C(tz, tz)) and sqrt(C(f, f)) for a pixel
+  // noise of 1 px (multiply by rms_px for the observed noise); 0 when J^T J
+  // is numerically singular.
+  double tz_stddev_at_1px = 0;
+  double focal_stddev_at_1px = 0;
+  // False when J^T J is numerically singular, focal_stddev_at_1px >
+  // kMaxRelativeStddevAt1px f, or tz_stddev_at_1px > kMaxRelativeStddevAt1px
+  // times the median depth of the inliers: f or tz is then poorly determined
+  // (too little depth variation, too few points or too narrow a view).
+  bool well_conditioned = false;
 
   std::string error_message;  // why UpgradeCamera returned false
 };
 
-// |tz_focal_correlation| above which the upgrade is reported as not well
-// conditioned.
-constexpr double kMaxWellConditionedCorrelation = 0.999;
+// Largest relative uncertainty of f and tz (at 1 px noise) of a well
+// conditioned upgrade.
+constexpr double kMaxRelativeStddevAt1px = 0.01;
 
 // Whether UpgradeCamera supports the COLMAP camera model: SIMPLE_PINHOLE,
 // PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, SIMPLE_RADIAL_FISHEYE,

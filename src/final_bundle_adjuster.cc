@@ -1,7 +1,6 @@
 #include "src/final_bundle_adjuster.h"
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 #include <colmap/base/camera_models.h>
 #include <glog/logging.h>
 
@@ -540,10 +539,11 @@ bool RigAdjustment::Solve(ceres::Solver::Summary* summary) {
   }
   SetUpParameterBlocks(&problem);
   const ceres::Solver::Options solver_options = SolverOptions(problem);
-  LOG(INFO) << "Final bundle adjustment: " << problem.NumResidualBlocks()
-            << " observations (" << problem.NumResiduals() << " residuals), "
-            << problem.NumParameterBlocks() << " parameter blocks";
+  VLOG(1) << "Final bundle adjustment: " << problem.NumResidualBlocks()
+          << " observations (" << problem.NumResiduals() << " residuals), "
+          << problem.NumParameterBlocks() << " parameter blocks";
   ceres::Solve(solver_options, &problem, summary);
+  VLOG(1) << summary->BriefReport();
   VLOG(1) << summary->FullReport();
   if (!summary->IsSolutionUsable()) {
     LOG(ERROR) << "Final bundle adjustment failed: " << summary->message;
@@ -745,8 +745,8 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& options,
     }
     const size_t num_pruned =
         adjustment.RejectOutliers(/*prune_residuals=*/true);
-    LOG(INFO) << "Final bundle adjustment: pruned " << num_pruned
-              << " outlier observations";
+    VLOG(1) << "Final bundle adjustment: pruned " << num_pruned
+            << " outlier observations";
     if (num_pruned == 0) {
       break;
     }
@@ -765,10 +765,10 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& options,
   result.seconds = std::chrono::duration<double>(
                        std::chrono::steady_clock::now() - start_time)
                        .count();
-  LOG(INFO) << "Final bundle adjustment: RMS " << result.initial_rms_px
-            << " -> " << result.final_rms_px << " px over "
-            << result.num_residuals << " observations, " << result.num_outliers
-            << " outliers, " << result.seconds << " s";
+  VLOG(1) << "Final bundle adjustment: RMS " << result.initial_rms_px << " -> "
+          << result.final_rms_px << " px over " << result.num_residuals
+          << " observations, " << result.num_outliers << " outliers, "
+          << result.seconds << " s";
   if (summary != nullptr) {
     *summary = result;
   }

@@ -68,8 +68,8 @@ bool EstimateWithKnownIntrinsics(const InitialPoseOptions& options,
   refinement.refine_focal_length = false;
   refinement.refine_extra_params = false;
   refinement.print_summary = false;
-  colmap::RefineAbsolutePose(refinement, inlier_mask, points2D, points3D,
-                             &qvec, &tvec, &camera_copy);
+  colmap::RefineAbsolutePose(refinement, inlier_mask, points2D, points3D, &qvec,
+                             &tvec, &camera_copy);
   result->single_image_cam_from_world = Rigid3d::FromQvecTvec(qvec, tvec);
   result->inlier_mask = std::move(inlier_mask);
   result->num_inliers = static_cast<int>(num_inliers);
@@ -150,7 +150,8 @@ void EstimateInitialPoses(const InitialPoseOptions& options,
   std::atomic<int> num_localized(0);
   const int progress_step = std::max(1, num_images / 10);
 
-#pragma omp parallel for schedule(dynamic) num_threads(NumThreads(options.num_threads))
+#pragma omp parallel for schedule(dynamic) \
+    num_threads(NumThreads(options.num_threads))
   for (int i = 0; i < num_images; ++i) {
     const RigImage& image = dataset.images[i];
     const colmap::Camera& camera = dataset.cameras[image.camera_index].camera;
@@ -164,7 +165,8 @@ void EstimateInitialPoses(const InitialPoseOptions& options,
         localized = EstimateRadial(options, image, camera, &result);
         break;
       case InitialPoseModel::kKnownIntrinsics:
-        localized = EstimateWithKnownIntrinsics(options, image, camera, &result);
+        localized =
+            EstimateWithKnownIntrinsics(options, image, camera, &result);
         break;
       case InitialPoseModel::kPoseAndIntrinsics:
         localized = EstimatePoseAndIntrinsics(options, image, camera, &result,

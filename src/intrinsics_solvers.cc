@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 
 namespace rig_calibrator {
 namespace {
@@ -22,8 +21,13 @@ constexpr double kGridRange = 30;
 // Local minima of the grid refined, and solutions returned.
 constexpr size_t kMaxNumRefinedMinima = 5;
 constexpr size_t kMaxNumCandidates = 3;
-// Golden-section search stops when the bracket has shrunk by this factor.
+// Brent's search stops when the minimum is known to within this fraction of
+// its initial bracket.
 constexpr double kRelativeTzTolerance = 1e-10;
+constexpr int kMaxNumBrentIterations = 100;
+// Smallest Cholesky pivot (a square root, so ~1e-14 in the eigenvalues) of
+// the equilibrated normal equations of FitRadialProfile.
+constexpr double kMinCholeskyPivot = 1e-7;
 
 // s = x.(a, b) / |x|, the signed radial coordinate of the 3D point along the
 // image point's direction; 0 for a point on the principal point, which
@@ -60,6 +64,107 @@ double Median(std::vector<double> values) {
   return values[middle];
 }
 
+// FitRadialProfile with a fixed number of radial terms. The variable
+// projection calls it hundreds of times per estimate: normal equations of at
+// most 3 unknowns in fixed-size matrices, then the residuals in a second pass
+// (no cancellation in the error).
+template <int kNumRadialTerms>
+bool FitRadialProfileWithTerms(const std::vector<Eigen::Vector2d>& x,
+                               const std::vector<Eigen::Vector3d>& points_cam,
+                               RadialIntrinsics* model, double* squared_error) {
+  constexpr int kNumUnknowns = kNumRadialTerms + 1;
+  typedef Eigen::Matrix<double, kNumUnknowns, 1> Vector;
+  typedef Eigen::Matrix<double, kNumUnknowns, kNumUnknowns> Matrix;
+  const int num_points = static_cast<int>(x.size());
+  if (num_points < kNumUnknowns) {
+    return false;
+  }
+  const auto basis = [&](const int i) {
+    const double depth = points_cam[i].z() + model->tz;
+    const double s = SignedRadialCoordinate(x[i], points_cam[i]);
+    // An odd function of s, so that a point on the wrong half-line (s < 0)
+    // predicts a negative radius and a large residual.
+    const double phi = model->profile == RadialProfile::kPolynomial
+                           ? s / depth
+                           : std::atan2(s, depth);
+    Vector row;
+    double phi_power = phi;
+    for (int j = 0; j < kNumUnknowns; ++j) {
+      row(j) = phi_power;
+      phi_power *= phi * phi;
+    }
+    return row;
+  };
+  Matrix AtA = Matrix::Zero();
+  Vector Atb = Vector::Zero();
+  for (int i = 0; i < num_points; ++i) {
+    if (!(points_cam[i].z() + model->tz > 0)) {
+      return false;
+    }
+    const Vector row = basis(i);
+    AtA.noalias() += row * row.transpose();
+    Atb.noalias() += x[i].norm() * row;
+  }
+  const Vector diagonal = AtA.diagonal();
+  if (!AtA.allFinite() || !Atb.allFinite() || (diagonal.array() <= 0).any()) {
+    return false;
+  }
+  // Equilibrated to a unit diagonal, so that a small Cholesky pivot means a
+  // nearly dependent basis whatever the magnitudes of phi, phi^3, phi^5.
+  const Vector scales = diagonal.cwiseSqrt().cwiseInverse();
+  const Eigen::LLT<Matrix> llt(scales.asDiagonal() * AtA * scales.asDiagonal());
+  if (llt.info() != Eigen::Success ||
+      !(llt.matrixLLT().diagonal().minCoeff() > kMinCholeskyPivot)) {
+    return false;
+  }
+  const Vector beta =
+      scales.asDiagonal() * llt.solve(scales.asDiagonal() * Atb);
+  if (!beta.allFinite() || !(beta(0) > 0)) {
+    return false;
+  }
+  *squared_error = 0;
+  for (int i = 0; i < num_points; ++i) {
+    const double residual = x[i].norm() - basis(i).dot(beta);
+    *squared_error += residual * residual;
+  }
+  model->focal = beta(0);
+  model->k[0] = model->k[1] = 0;
+  for (int j = 1; j < kNumUnknowns; ++j) {
+    model->k[j - 1] = beta(j) / beta(0);
+  }
+  return std::isfinite(*squared_error);
+}
+
+// Whether r_d grows with the ray angle over the angles of the points:
+// d r_d / d phi = f (1 + 3 k1 phi^2 + 5 k2 phi^4) > 0 for phi in [0, max_phi].
+// A profile that folds back can fit points on the wrong half-line (a
+// negative 1 + k1 phi^2 + k2 phi^4 mirrors them through the principal point)
+// and is not a lens.
+bool IsMonotonicOverPoints(const std::vector<Eigen::Vector2d>& x,
+                           const std::vector<Eigen::Vector3d>& points_cam,
+                           const RadialIntrinsics& model) {
+  double max_phi = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double depth = points_cam[i].z() + model.tz;
+    const double s = std::abs(SignedRadialCoordinate(x[i], points_cam[i]));
+    max_phi = std::max(max_phi, model.profile == RadialProfile::kPolynomial
+                                    ? s / depth
+                                    : std::atan2(s, depth));
+  }
+  // g(t) = 1 + 3 k1 t + 5 k2 t^2 on t = phi^2 in [0, max_phi^2]: its minimum
+  // is at an end or at the vertex.
+  const double t_max = max_phi * max_phi;
+  const auto g = [&](double t) {
+    return 1 + 3 * model.k[0] * t + 5 * model.k[1] * t * t;
+  };
+  double min_g = std::min(g(0), g(t_max));
+  if (model.k[1] != 0) {
+    const double vertex = -3 * model.k[0] / (10 * model.k[1]);
+    if (vertex > 0 && vertex < t_max) min_g = std::min(min_g, g(vertex));
+  }
+  return model.focal > 0 && min_g > 0;
+}
+
 // E(tz) of the variable projection; infinite where FitRadialProfile fails.
 double ProfileError(const std::vector<Eigen::Vector2d>& x,
                     const std::vector<Eigen::Vector3d>& points_cam,
@@ -72,32 +177,88 @@ double ProfileError(const std::vector<Eigen::Vector2d>& x,
   return squared_error;
 }
 
-// Golden-section search for the minimum of E over [lo, hi].
+// Brent's method (golden-section steps safeguarding parabolic interpolation)
+// for the minimum of E over [lo, hi]. Stops when x is known to within
+// kRelativeTzTolerance (hi - lo), or a few ulps of x.
 double MinimizeProfileError(const std::vector<Eigen::Vector2d>& x,
                             const std::vector<Eigen::Vector3d>& points_cam,
-                            const RadialIntrinsics& model, double lo, double hi,
-                            double tolerance) {
-  const double ratio = (std::sqrt(5.0) - 1) / 2;
-  double x1 = hi - ratio * (hi - lo);
-  double x2 = lo + ratio * (hi - lo);
-  double e1 = ProfileError(x, points_cam, model, x1);
-  double e2 = ProfileError(x, points_cam, model, x2);
-  while (hi - lo > tolerance) {
-    if (e1 < e2) {
-      hi = x2;
-      x2 = x1;
-      e2 = e1;
-      x1 = hi - ratio * (hi - lo);
-      e1 = ProfileError(x, points_cam, model, x1);
+                            const RadialIntrinsics& model, double lo,
+                            double hi) {
+  const auto E = [&](double tz) {
+    return ProfileError(x, points_cam, model, tz);
+  };
+  const double golden = (3 - std::sqrt(5.0)) / 2;
+  const double absolute_tolerance = kRelativeTzTolerance * (hi - lo);
+  // Best, second best and previous second best points and their errors.
+  double best = lo + golden * (hi - lo);
+  double second = best;
+  double third = best;
+  double e_best = E(best);
+  double e_second = e_best;
+  double e_third = e_best;
+  double step = 0;
+  double previous_step = 0;
+  for (int iteration = 0; iteration < kMaxNumBrentIterations; ++iteration) {
+    const double middle = (lo + hi) / 2;
+    const double tolerance =
+        absolute_tolerance +
+        4 * std::numeric_limits<double>::epsilon() * std::abs(best);
+    if (std::abs(best - middle) <= 2 * tolerance - (hi - lo) / 2) {
+      break;
+    }
+    bool parabolic = false;
+    if (std::abs(previous_step) > tolerance) {
+      // Vertex of the parabola through best, second and third.
+      const double r = (best - second) * (e_best - e_third);
+      double q = (best - third) * (e_best - e_second);
+      double p = (best - third) * q - (best - second) * r;
+      q = 2 * (q - r);
+      if (q > 0) {
+        p = -p;
+      } else {
+        q = -q;
+      }
+      if (std::abs(p) < std::abs(q * previous_step / 2) &&
+          p > q * (lo - best) && p < q * (hi - best)) {
+        previous_step = step;
+        step = p / q;
+        const double next = best + step;
+        if (next - lo < 2 * tolerance || hi - next < 2 * tolerance) {
+          step = best < middle ? tolerance : -tolerance;
+        }
+        parabolic = true;
+      }
+    }
+    if (!parabolic) {
+      previous_step = (best < middle ? hi : lo) - best;
+      step = golden * previous_step;
+    }
+    const double next = best + (std::abs(step) >= tolerance
+                                    ? step
+                                    : (step > 0 ? tolerance : -tolerance));
+    const double e_next = E(next);
+    if (e_next <= e_best) {
+      (next < best ? hi : lo) = best;
+      third = second;
+      e_third = e_second;
+      second = best;
+      e_second = e_best;
+      best = next;
+      e_best = e_next;
     } else {
-      lo = x1;
-      x1 = x2;
-      e1 = e2;
-      x2 = lo + ratio * (hi - lo);
-      e2 = ProfileError(x, points_cam, model, x2);
+      (next < best ? lo : hi) = next;
+      if (e_next <= e_second || second == best) {
+        third = second;
+        e_third = e_second;
+        second = next;
+        e_second = e_next;
+      } else if (e_next <= e_third || third == best || third == second) {
+        third = next;
+        e_third = e_next;
+      }
     }
   }
-  return e1 < e2 ? x1 : x2;
+  return best;
 }
 
 }  // namespace
@@ -176,49 +337,25 @@ bool SolveDivisionIntrinsics(const std::vector<Eigen::Vector2d>& x,
 bool FitRadialProfile(const std::vector<Eigen::Vector2d>& x,
                       const std::vector<Eigen::Vector3d>& points_cam,
                       RadialIntrinsics* model, double* squared_error) {
-  const int num_points = static_cast<int>(x.size());
-  const int num_unknowns = model->num_radial_terms + 1;
-  if (model->num_radial_terms < 0 || model->num_radial_terms > 2 ||
-      points_cam.size() != x.size() || num_points < num_unknowns) {
+  if (points_cam.size() != x.size()) {
     return false;
   }
-  Eigen::MatrixXd A(num_points, num_unknowns);
-  Eigen::VectorXd b(num_points);
-  for (int i = 0; i < num_points; ++i) {
-    const double depth = points_cam[i].z() + model->tz;
-    if (!(depth > 0)) {
+  switch (model->num_radial_terms) {
+    case 0:
+      return FitRadialProfileWithTerms<0>(x, points_cam, model, squared_error);
+    case 1:
+      return FitRadialProfileWithTerms<1>(x, points_cam, model, squared_error);
+    case 2:
+      return FitRadialProfileWithTerms<2>(x, points_cam, model, squared_error);
+    default:
       return false;
-    }
-    const double s = SignedRadialCoordinate(x[i], points_cam[i]);
-    // An odd function of s, so that a point on the wrong half-line (s < 0)
-    // predicts a negative radius and a large residual.
-    const double phi = model->profile == RadialProfile::kPolynomial
-                           ? s / depth
-                           : std::atan2(s, depth);
-    double phi_power = phi;
-    for (int j = 0; j < num_unknowns; ++j) {
-      A(i, j) = phi_power;
-      phi_power *= phi * phi;
-    }
-    b(i) = x[i].norm();
   }
-  Eigen::VectorXd beta;
-  if (!SolveEquilibratedLeastSquares(A, b, &beta) || !(beta(0) > 0)) {
-    return false;
-  }
-  model->focal = beta(0);
-  model->k[0] = model->k[1] = 0;
-  for (int j = 1; j < num_unknowns; ++j) {
-    model->k[j - 1] = beta(j) / beta(0);
-  }
-  *squared_error = (A * beta - b).squaredNorm();
-  return std::isfinite(*squared_error);
 }
 
 std::vector<RadialIntrinsics> EstimateRadialIntrinsics(
     const std::vector<Eigen::Vector2d>& x,
-    const std::vector<Eigen::Vector3d>& points_cam,
-    const RadialProfile profile, const int num_radial_terms) {
+    const std::vector<Eigen::Vector3d>& points_cam, const RadialProfile profile,
+    const int num_radial_terms) {
   std::vector<double> c(points_cam.size());
   for (size_t i = 0; i < points_cam.size(); ++i) {
     c[i] = points_cam[i].z();
@@ -272,10 +409,10 @@ std::vector<RadialIntrinsics> EstimateRadialIntrinsics(
     const double lo = grid[std::max(j - 1, 0)];
     const double hi = grid[std::min(j + 1, kNumGridPoints - 1)];
     RadialIntrinsics candidate = model;
-    candidate.tz = MinimizeProfileError(x, points_cam, model, lo, hi,
-                                        kRelativeTzTolerance * (hi - lo));
+    candidate.tz = MinimizeProfileError(x, points_cam, model, lo, hi);
     double squared_error = 0;
-    if (FitRadialProfile(x, points_cam, &candidate, &squared_error)) {
+    if (FitRadialProfile(x, points_cam, &candidate, &squared_error) &&
+        IsMonotonicOverPoints(x, points_cam, candidate)) {
       candidates.emplace_back(squared_error, candidate);
     }
   }

@@ -81,11 +81,12 @@ bool FitRadialProfile(const std::vector<Eigen::Vector2d>& x,
 // E(tz) = FitRadialProfile's squared error over tz. tz is bracketed by a
 // log-spaced grid over the depth of the nearest point, tz + min(c), from 1/30
 // to 30 times its value under SolveDivisionIntrinsics (num_kappa =
-// num_radial_terms); the lowest local minima of the grid are refined by
-// golden-section search. Returns up to 3 solutions, best first. With
-// num_radial_terms + 2 points E vanishes at every solution of the minimal
-// problem, hence several candidates; with more points the first is the
-// estimate.
+// num_radial_terms, or the spread median(c) - min(c) when that fails); the 5
+// lowest local minima of the grid are refined by Brent's method. Solutions
+// whose r_d does not grow with the ray angle over the points are dropped.
+// Returns up to 3 solutions, best first. With num_radial_terms + 2 points E
+// vanishes at every solution of the minimal problem, hence several
+// candidates; with more points the first is the estimate.
 std::vector<RadialIntrinsics> EstimateRadialIntrinsics(
     const std::vector<Eigen::Vector2d>& x,
     const std::vector<Eigen::Vector3d>& points_cam, RadialProfile profile,

@@ -286,7 +286,8 @@ void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
   // (image index, correspondence index) of every upgrade input row.
   std::vector<std::vector<std::pair<int, int>>> rows(num_cameras);
 
-#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, options.num_threads > 0 ? options.num_threads : num_cameras))
+#pragma omp parallel for schedule(dynamic) num_threads( \
+    std::max(1, options.num_threads > 0 ? options.num_threads : num_cameras))
   for (int c = 0; c < num_cameras; ++c) {
     if (!calibration->camera_calibrated[c]) continue;
     std::vector<Eigen::Vector2d> points2D;
@@ -296,7 +297,8 @@ void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
       if (image.camera_index != c || !FramesetPosed(*calibration, image)) {
         continue;
       }
-      const Rigid3d cam_from_world = calibration->CamFromWorld(c, image.frameset_index);
+      const Rigid3d cam_from_world =
+          calibration->CamFromWorld(c, image.frameset_index);
       for (size_t k = 0; k < image.correspondences.size(); ++k) {
         if (!calibration->images[i].inlier_mask[k]) continue;
         points2D.push_back(image.correspondences[k].point2D);
@@ -346,10 +348,10 @@ void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
     }
     if (options.print_progress) {
       std::cout << "  " << dataset.cameras[c].name << ": "
-                << results[c].num_inliers << " inliers, tz "
-                << results[c].tz << ", " << calibration->cameras[c].ModelName()
-                << " " << calibration->cameras[c].ParamsToString()
-                << ", RMS " << results[c].rms_px << " px" << std::endl;
+                << results[c].num_inliers << " inliers, tz " << results[c].tz
+                << ", " << calibration->cameras[c].ModelName() << " "
+                << calibration->cameras[c].ParamsToString() << ", RMS "
+                << results[c].rms_px << " px" << std::endl;
     }
   }
 }
@@ -380,7 +382,8 @@ bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
     init_options.seed = options.seed;
     RigInitializerSummary summary;
     if (!InitializeRig(init_options, dataset, calibration, &summary)) {
-      report->error = "the radial rig initialization failed: " + summary.message;
+      report->error =
+          "the radial rig initialization failed: " + summary.message;
       return false;
     }
   }
@@ -505,7 +508,8 @@ bool ValidateDataset(const RigDataset& dataset, std::string* error) {
   for (const RigImage& image : dataset.images) {
     if (image.camera_index < 0 || image.camera_index >= num_cameras ||
         image.frameset_index < 0 ||
-        image.frameset_index >= static_cast<int>(dataset.frameset_names.size())) {
+        image.frameset_index >=
+            static_cast<int>(dataset.frameset_names.size())) {
       *error = "image " + image.name + " has no valid camera or frameset";
       return false;
     }

@@ -80,8 +80,8 @@ struct PipelineReport {
   std::vector<Diagnostic> diagnostics;
   std::vector<StageTiming> timings;
   int num_images = 0;
-  int num_localized = 0;     // on their own, in the first stage
-  int num_used = 0;          // in the final calibration
+  int num_localized = 0;  // on their own, in the first stage
+  int num_used = 0;       // in the final calibration
   int num_framesets_posed = 0;
   double final_rms_px = 0;
   double total_seconds = 0;

@@ -1,5 +1,7 @@
 #include "src/radial_pose_estimator.h"
 
+#include <colmap/optim/loransac.h>
+#include <colmap/optim/support_measurement.h>
 #include <glog/logging.h>
 
 #include <Eigen/Cholesky>
@@ -7,8 +9,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <colmap/optim/loransac.h>
-#include <colmap/optim/support_measurement.h>
 #include <limits>
 
 #include "src/radial_pose_solver.h"
@@ -20,8 +20,8 @@ using Vector8d = Eigen::Matrix<double, 8, 1>;
 using Matrix5d = Eigen::Matrix<double, 5, 5>;
 using Vector5d = Eigen::Matrix<double, 5, 1>;
 
-// A radial pose in the normalized world frame X_n = (X - c) / s of the local
-// estimator: rotation and (tx, ty).
+// A radial pose in the normalized world frame X_n = (X - c) / s
+// (NormalizePoints): rotation and (tx, ty).
 struct RadialPose {
   Eigen::Matrix3d rotation;
   Eigen::Vector2d translation;
@@ -105,9 +105,9 @@ double Linearize(const RadialPose& pose,
 // Levenberg-Marquardt over (rotation, tx, ty) minimizing the Cauchy cost
 // sum s^2 log(1 + e_i^2 / s^2) of the radial errors e_i, s = loss_scale.
 void MinimizeCauchyRadialCost(const std::vector<Eigen::Vector2d>& points2D,
-                        const std::vector<Eigen::Vector3d>& points3D,
-                        double loss_scale, int max_num_iterations,
-                        RadialPose* pose) {
+                              const std::vector<Eigen::Vector3d>& points3D,
+                              double loss_scale, int max_num_iterations,
+                              RadialPose* pose) {
   const double scale_sq = loss_scale * loss_scale;
   Matrix5d hessian;
   Vector5d gradient;
@@ -206,12 +206,10 @@ Rigid3d FromNormalizedFrame(const RadialPose& pose,
                             const Eigen::Vector3d& centroid, double scale,
                             double tz) {
   const Eigen::Vector3d rotated_centroid = pose.rotation * centroid;
-  return Rigid3d(pose.rotation,
-                 Eigen::Vector3d(scale * pose.translation.x() -
-                                     rotated_centroid.x(),
-                                 scale * pose.translation.y() -
-                                     rotated_centroid.y(),
-                                 tz));
+  return Rigid3d(
+      pose.rotation,
+      Eigen::Vector3d(scale * pose.translation.x() - rotated_centroid.x(),
+                      scale * pose.translation.y() - rotated_centroid.y(), tz));
 }
 
 bool IsValidOptions(const RadialPoseEstimationOptions& options) {
@@ -356,8 +354,8 @@ bool RefineRadialPose(const RadialPoseEstimationOptions& options,
   constexpr int kMaxNumIterations = 50;
   MinimizeCauchyRadialCost(inlier_points2D, normalized_points3D,
                            options.loss_scale_px, kMaxNumIterations, &pose);
-  const Rigid3d refined = FromNormalizedFrame(
-      pose, centroid, scale, cam_from_world->translation.z());
+  const Rigid3d refined = FromNormalizedFrame(pose, centroid, scale,
+                                              cam_from_world->translation.z());
   if (!refined.rotation.coeffs().allFinite() ||
       !refined.translation.allFinite()) {
     return false;
@@ -382,11 +380,10 @@ bool EstimateRadialPose(const RadialPoseEstimationOptions& options,
     return false;
   }
   const size_t num_points = points3D.size();
-  if (num_points < static_cast<size_t>(std::max(
-                       RadialPoseEstimator::kMinNumSamples,
-                       options.min_num_inliers))) {
-    VLOG(2) << "EstimateRadialPose: only " << num_points
-            << " correspondences";
+  if (num_points <
+      static_cast<size_t>(std::max(RadialPoseEstimator::kMinNumSamples,
+                                   options.min_num_inliers))) {
+    VLOG(2) << "EstimateRadialPose: only " << num_points << " correspondences";
     return false;
   }
 

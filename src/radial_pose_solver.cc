@@ -70,8 +70,8 @@ int SolveMonicCubicReal(double a2, double a1, double a0, double roots[3]) {
     roots[2] = scale * std::cos((theta - 2 * M_PI) / 3) - shift;
     num_roots = 3;
   } else {
-    const double a =
-        -std::copysign(std::cbrt(std::abs(r) + std::sqrt(r * r - q * q * q)), r);
+    const double a = -std::copysign(
+        std::cbrt(std::abs(r) + std::sqrt(r * r - q * q * q)), r);
     const double b = a == 0 ? 0 : q / a;
     roots[0] = a + b - shift;
     num_roots = 1;
@@ -144,9 +144,11 @@ int SolveQuarticReal(const double c_in[5], double roots[4]) {
 
 // Polynomials in a, as coefficient arrays in increasing degree.
 template <int N, int M>
-Eigen::Matrix<double, N + M - 1, 1> PolyMul(const Eigen::Matrix<double, N, 1>& f,
-                                            const Eigen::Matrix<double, M, 1>& g) {
-  Eigen::Matrix<double, N + M - 1, 1> h = Eigen::Matrix<double, N + M - 1, 1>::Zero();
+Eigen::Matrix<double, N + M - 1, 1> PolyMul(
+    const Eigen::Matrix<double, N, 1>& f,
+    const Eigen::Matrix<double, M, 1>& g) {
+  Eigen::Matrix<double, N + M - 1, 1> h =
+      Eigen::Matrix<double, N + M - 1, 1>::Zero();
   for (int i = 0; i < N; ++i) {
     for (int j = 0; j < M; ++j) h(i + j) += f(i) * g(j);
   }
@@ -165,7 +167,8 @@ bool NormalizeRadialRows(Vector8d* p) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen;
   eigen.computeDirect(gram);
   const Eigen::Vector2d singular_sq = eigen.eigenvalues();
-  if (!(singular_sq(0) > 1e-20 * singular_sq(1)) || !std::isfinite(singular_sq(1))) {
+  if (!(singular_sq(0) > 1e-20 * singular_sq(1)) ||
+      !std::isfinite(singular_sq(1))) {
     return false;
   }
   const Eigen::Vector2d singular = singular_sq.cwiseSqrt();

@@ -30,13 +30,13 @@ Eigen::Vector3d PointOnWalk(const SceneWalk& walk, double scale, double phi,
 }
 
 // `count` ellipse parameters phi in [0, 2 pi), spaced evenly in the cost
-// sqrt(ds^2 + (10 m * dphi)^2): the heading follows phi, so on a long, thin
+// sqrt(ds^2 + (12 m * dphi)^2): the heading follows phi, so on a long, thin
 // ellipse (the street) views are spaced by distance along the sides and by
 // turning angle at the ends, instead of turning 60 degrees between two views.
 std::vector<double> EvenlySpacedAngles(const SceneWalk& walk, double scale,
                                        int count, double offset) {
   constexpr int kSteps = 20000;
-  constexpr double kTurnWeightMeters = 10.0;
+  constexpr double kTurnWeightMeters = 12.0;
   std::vector<double> cumulative(kSteps + 1, 0.0);
   for (int k = 0; k < kSteps; ++k) {
     const double phi = (k + 0.5) * 2.0 * M_PI / kSteps;
@@ -181,7 +181,7 @@ bool PlanRenderedDataset(const RenderedDatasetOptions& options,
       return false;
     }
     const Rigid3d world_from_body = WorldFromBody(
-        position, phi + 30.0 * kDegree * std::sin(3.0 * phi + yaw_phase),
+        position, phi + 30.0 * kDegree * std::sin(2.0 * phi + yaw_phase),
         mean_pitch + pitch_swing * std::sin(5.0 * phi + pitch_phase),
         4.0 * kDegree * std::sin(7.0 * phi + roll_phase));
     plan->map_image_names.push_back("map_" + Numbered(i) + ".png");

@@ -57,7 +57,7 @@ struct RenderedDatasetPlan {
 };
 
 // Fails (with a message) for invalid options, or when a camera would stand
-// inside or within 0.25 m of a surface (e.g. the 4.5 m car rig in the room).
+// inside or within 0.25 m of a surface.
 bool PlanRenderedDataset(const RenderedDatasetOptions& options,
                          RenderedDatasetPlan* plan, std::string* error);
 

@@ -34,9 +34,14 @@ constexpr int kMaxScoredCorrespondences = 64;
 // the test meaningful when the principal point is still off.
 constexpr int kMinAgreeingInliers = 5;
 constexpr double kMinAgreementRatio = 0.5;
-// A camera's pose in the rig is the best supported of its per-frameset
-// candidates; an evenly spread subset bounds the quadratic cost.
-constexpr int kMaxCameraCandidates = 50;
+// Consensus rotations compare every candidate with every other: an evenly
+// spread subset bounds the quadratic cost.
+constexpr int kMaxRotationCandidates = 50;
+// Sweeps re-estimating every rotation after the greedy assignment.
+constexpr int kNumRotationSweeps = 2;
+// A camera takes part in an undetermined direction of the translations if
+// the direction's unit eigenvector has at least this norm on its unknowns.
+constexpr double kUndeterminedComponent = 0.1;
 // A kept camera needs this many agreeing images: a wrong per-image pose
 // always agrees with the camera pose made from it.
 constexpr int kMinAgreeingImagesPerCamera = 2;
@@ -60,6 +65,7 @@ struct InitProblem {
   // Smallest eigenvalue of sum_k (I - z_k z_k^T) over the cameras' axes z_k
   // that determines a rig translation in eq. 3: 1 - cos(minimum angle).
   double min_axis_eigenvalue = 0;
+  double max_rotation_deviation = 0;  // radians
   int num_threads = 1;
   std::vector<LocalizedImage> images;
   std::vector<std::vector<int>> images_of_frameset;
@@ -114,228 +120,6 @@ double SmallestAxisEigenvalue(const std::vector<Eigen::Vector3d>& axes) {
       .eigenvalues()(0);
 }
 
-// P = T Q^-1; the first two rows of P only depend on those of T.
-Rigid3d CamFromRigCandidate(const Rigid3d& cam_from_world,
-                            const Rigid3d& rig_from_world, bool radial) {
-  Rigid3d cam_from_rig = cam_from_world * rig_from_world.Inverse();
-  if (radial) cam_from_rig.translation.z() = 0;
-  return cam_from_rig;
-}
-
-// Eq. 3: the rig pose Q from stacked known rows, [B_k | b_k] = [A_k | a_k] Q
-// with [A_k | a_k] the known rows of P_k and [B_k | b_k] those of T_k.
-// Rotation: Procrustes, argmax_R <sum_k A_k^T B_k, R> over SO(3). Translation:
-// linear least squares, (sum_k A_k^T A_k) t = sum_k A_k^T (b_k - a_k).
-std::optional<Rigid3d> SolveRigFromWorld(
-    const InitProblem& problem,
-    const std::vector<std::pair<const Rigid3d*, const Rigid3d*>>&
-        cam_from_rig_and_cam_from_world) {
-  const int rows = problem.num_rows;
-  Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> axes;
-  for (const auto& [cam_from_rig, cam_from_world] :
-       cam_from_rig_and_cam_from_world) {
-    const Eigen::Matrix3d rig_rotation = cam_from_rig->RotationMatrix();
-    const Eigen::Matrix3d world_rotation = cam_from_world->RotationMatrix();
-    const auto a_rot = rig_rotation.topRows(rows);
-    correlation += a_rot.transpose() * world_rotation.topRows(rows);
-    normal += a_rot.transpose() * a_rot;
-    rhs += a_rot.transpose() * (cam_from_world->translation.head(rows) -
-                                cam_from_rig->translation.head(rows));
-    axes.push_back(rig_rotation.row(2).transpose());
-  }
-  if (axes.empty() || (rows == 2 && SmallestAxisEigenvalue(axes) <
-                                        problem.min_axis_eigenvalue)) {
-    return std::nullopt;
-  }
-  return Rigid3d(NearestRotation(correlation), normal.ldlt().solve(rhs));
-}
-
-// How well a candidate pose explains a set of images: images that agree
-// with it (Agree) first, then the truncated score.
-struct Support {
-  int num_agreeing = 0;
-  double truncated_sq_sum = 0;
-  bool BetterThan(const Support& other) const {
-    return num_agreeing != other.num_agreeing
-               ? num_agreeing > other.num_agreeing
-               : truncated_sq_sum < other.truncated_sq_sum;
-  }
-};
-
-void AddToSupport(const Rigid3d& cam_from_world, const LocalizedImage& image,
-                  double max_error, Support* support) {
-  const ImageFit fit = FitImage(cam_from_world, image, max_error);
-  support->num_agreeing += Agree(image.num_own_inliers, fit.num_within);
-  support->truncated_sq_sum += fit.truncated_sq_sum;
-}
-
-// Q_j of one frameset from the images of its assigned cameras. With more
-// images than needed, the solutions leaving one image out compete with the
-// one using all, so one wrong per-image pose does not spoil the frameset.
-// The winner must be confirmed by its images: at least two must agree with
-// it when radial (one when full), otherwise the frameset stays unassigned
-// (for now: more assigned cameras may confirm it later).
-std::optional<Rigid3d> SolveFramesetRigPose(const InitProblem& problem,
-                                            const Hypothesis& hypothesis,
-                                            int frameset) {
-  std::vector<int> usable;
-  for (const int index : problem.images_of_frameset[frameset]) {
-    if (hypothesis.cam_from_rig[problem.images[index].camera]) {
-      usable.push_back(index);
-    }
-  }
-  const int min_images = problem.num_rows == 2 ? 2 : 1;
-  if (static_cast<int>(usable.size()) < min_images) return std::nullopt;
-
-  std::vector<int> left_out_candidates = {-1};
-  if (static_cast<int>(usable.size()) > min_images) {
-    left_out_candidates.insert(left_out_candidates.end(), usable.begin(),
-                               usable.end());
-  }
-  std::optional<Rigid3d> best;
-  Support best_support;
-  for (const int left_out : left_out_candidates) {
-    std::vector<std::pair<const Rigid3d*, const Rigid3d*>> pairs;
-    for (const int index : usable) {
-      if (index == left_out) continue;
-      const LocalizedImage& image = problem.images[index];
-      pairs.emplace_back(&*hypothesis.cam_from_rig[image.camera],
-                         &image.cam_from_world);
-    }
-    const std::optional<Rigid3d> candidate = SolveRigFromWorld(problem, pairs);
-    if (!candidate) continue;
-    Support support;
-    for (const int index : usable) {
-      const LocalizedImage& image = problem.images[index];
-      AddToSupport(*hypothesis.cam_from_rig[image.camera] * *candidate, image,
-                   problem.options.max_radial_error_px, &support);
-    }
-    if (!best || support.BetterThan(best_support)) {
-      best = candidate;
-      best_support = support;
-    }
-  }
-  if (best_support.num_agreeing < min_images) return std::nullopt;
-  return best;
-}
-
-// Candidate P_i = T_ij Q_j^-1 of camera i from each assigned frameset j that
-// sees it (an evenly spread subset bounds the quadratic cost), with its
-// support among those same images under P_i Q_j.
-struct CameraCandidate {
-  Rigid3d cam_from_rig;
-  Support support;
-};
-
-std::optional<CameraCandidate> BestCamFromRig(const InitProblem& problem,
-                                              const Hypothesis& hypothesis,
-                                              int camera) {
-  std::vector<int> seen;
-  for (const int index : problem.images_of_camera[camera]) {
-    if (hypothesis.rig_from_world[problem.images[index].frameset]) {
-      seen.push_back(index);
-    }
-  }
-  if (seen.empty()) return std::nullopt;
-  if (seen.size() > kMaxCameraCandidates) {
-    std::vector<int> subset;
-    for (int k = 0; k < kMaxCameraCandidates; ++k) {
-      subset.push_back(seen[k * seen.size() / kMaxCameraCandidates]);
-    }
-    seen.swap(subset);
-  }
-  std::optional<CameraCandidate> best;
-  for (const int candidate_index : seen) {
-    const LocalizedImage& candidate_image = problem.images[candidate_index];
-    CameraCandidate candidate;
-    candidate.cam_from_rig = CamFromRigCandidate(
-        candidate_image.cam_from_world,
-        *hypothesis.rig_from_world[candidate_image.frameset],
-        problem.num_rows == 2);
-    for (const int index : seen) {
-      const LocalizedImage& image = problem.images[index];
-      AddToSupport(
-          candidate.cam_from_rig * *hypothesis.rig_from_world[image.frameset],
-          image, problem.options.max_radial_error_px, &candidate.support);
-    }
-    if (!best || candidate.support.BetterThan(best->support)) {
-      best = candidate;
-    }
-  }
-  return best;
-}
-
-// One RANSAC hypothesis: the seed frameset places its cameras relative to a
-// base camera (the rig frame of this hypothesis is the base camera's frame,
-// with its tz = 0 when radial), then rig poses and camera poses are assigned
-// alternately until nothing changes. Cameras confirmed by two of their images
-// are placed before cameras resting on one image, because a wrong per-image
-// pose always agrees with the camera pose made from it.
-Hypothesis AssignGreedily(const InitProblem& problem, int seed_frameset) {
-  Hypothesis hypothesis;
-  hypothesis.cam_from_rig.resize(problem.num_cameras);
-  hypothesis.rig_from_world.resize(problem.num_framesets);
-
-  const std::vector<int>& seed_images =
-      problem.images_of_frameset[seed_frameset];
-  int base = seed_images.front();
-  for (const int index : seed_images) {
-    if (problem.images[index].camera == problem.reference_camera) base = index;
-  }
-  const Rigid3d seed_rig_from_world = problem.images[base].cam_from_world;
-  hypothesis.rig_from_world[seed_frameset] = seed_rig_from_world;
-  for (const int index : seed_images) {
-    const LocalizedImage& image = problem.images[index];
-    hypothesis.cam_from_rig[image.camera] = CamFromRigCandidate(
-        image.cam_from_world, seed_rig_from_world, problem.num_rows == 2);
-  }
-
-  std::vector<std::optional<Rigid3d>> new_rig_poses(problem.num_framesets);
-  std::vector<std::optional<CameraCandidate>> new_cam_poses(
-      problem.num_cameras);
-  while (true) {
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
-    for (int j = 0; j < problem.num_framesets; ++j) {
-      new_rig_poses[j] = hypothesis.rig_from_world[j]
-                             ? std::nullopt
-                             : SolveFramesetRigPose(problem, hypothesis, j);
-    }
-    bool changed = false;
-    for (int j = 0; j < problem.num_framesets; ++j) {
-      if (new_rig_poses[j]) {
-        hypothesis.rig_from_world[j] = new_rig_poses[j];
-        changed = true;
-      }
-    }
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
-    for (int i = 0; i < problem.num_cameras; ++i) {
-      new_cam_poses[i] = hypothesis.cam_from_rig[i]
-                             ? std::nullopt
-                             : BestCamFromRig(problem, hypothesis, i);
-    }
-    int best_num_agreeing = 0;
-    for (const std::optional<CameraCandidate>& candidate : new_cam_poses) {
-      if (candidate) {
-        best_num_agreeing =
-            std::max(best_num_agreeing, candidate->support.num_agreeing);
-      }
-    }
-    const int min_agreeing = std::clamp(best_num_agreeing, 1, 2);
-    for (int i = 0; i < problem.num_cameras; ++i) {
-      if (new_cam_poses[i] &&
-          new_cam_poses[i]->support.num_agreeing >= min_agreeing) {
-        hypothesis.cam_from_rig[i] = new_cam_poses[i]->cam_from_rig;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  return hypothesis;
-}
-
 // Per localized image: its fit under the hypothesis, or nullopt if its camera
 // or frameset is unassigned.
 std::vector<std::optional<ImageFit>> FitHypothesis(
@@ -378,6 +162,474 @@ std::vector<char> AgreeingImages(
                Agree(problem.images[k].num_own_inliers, fits[k]->num_within);
   }
   return agree;
+}
+
+// Rotation part of a hypothesis: R_P per camera, R_Q per frameset.
+struct Rotations {
+  std::vector<std::optional<Eigen::Quaterniond>> cam_from_rig;
+  std::vector<std::optional<Eigen::Quaterniond>> rig_from_world;
+};
+
+double AngleRad(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return 2 * std::acos(std::min(1.0, std::abs(a.dot(b))));
+}
+
+struct RotationEstimate {
+  Eigen::Quaterniond rotation;
+  int support = 0;  // candidates within the rotation tolerance of it
+};
+
+// The candidate most others agree with (within max_angle; ties: the smaller
+// sum of angles), refined as the chordal mean of the agreeing ones,
+// NearestRotation(sum_k R_k). An evenly spread subset bounds the cost.
+std::optional<RotationEstimate> ConsensusRotation(
+    std::vector<Eigen::Quaterniond> candidates, double max_angle) {
+  if (candidates.empty()) return std::nullopt;
+  if (candidates.size() > kMaxRotationCandidates) {
+    std::vector<Eigen::Quaterniond> subset;
+    for (int k = 0; k < kMaxRotationCandidates; ++k) {
+      subset.push_back(
+          candidates[k * candidates.size() / kMaxRotationCandidates]);
+    }
+    candidates.swap(subset);
+  }
+  int best = 0, best_support = -1;
+  double best_angle_sum = 0;
+  for (size_t m = 0; m < candidates.size(); ++m) {
+    int support = 0;
+    double angle_sum = 0;
+    for (const Eigen::Quaterniond& other : candidates) {
+      const double angle = AngleRad(candidates[m], other);
+      if (angle < max_angle) {
+        ++support;
+        angle_sum += angle;
+      }
+    }
+    if (support > best_support ||
+        (support == best_support && angle_sum < best_angle_sum)) {
+      best = m;
+      best_support = support;
+      best_angle_sum = angle_sum;
+    }
+  }
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (const Eigen::Quaterniond& other : candidates) {
+    if (AngleRad(candidates[best], other) < max_angle) {
+      sum += other.toRotationMatrix();
+    }
+  }
+  RotationEstimate estimate;
+  estimate.rotation = Eigen::Quaterniond(NearestRotation(sum));
+  estimate.support = best_support;
+  return estimate;
+}
+
+// R_Q of a frameset from its images of cameras with a rotation:
+// R_Q = R_P^T R_T per image.
+std::optional<RotationEstimate> FramesetRotation(const InitProblem& problem,
+                                                 const Rotations& rotations,
+                                                 int frameset) {
+  std::vector<Eigen::Quaterniond> candidates;
+  for (const int index : problem.images_of_frameset[frameset]) {
+    const LocalizedImage& image = problem.images[index];
+    if (rotations.cam_from_rig[image.camera]) {
+      candidates.push_back(rotations.cam_from_rig[image.camera]->conjugate() *
+                           image.cam_from_world.rotation);
+    }
+  }
+  return ConsensusRotation(candidates, problem.max_rotation_deviation);
+}
+
+// R_P of a camera from its images in framesets with a rotation:
+// R_P = R_T R_Q^T per image.
+std::optional<RotationEstimate> CameraRotation(const InitProblem& problem,
+                                               const Rotations& rotations,
+                                               int camera) {
+  std::vector<Eigen::Quaterniond> candidates;
+  for (const int index : problem.images_of_camera[camera]) {
+    const LocalizedImage& image = problem.images[index];
+    if (rotations.rig_from_world[image.frameset]) {
+      candidates.push_back(
+          image.cam_from_world.rotation *
+          rotations.rig_from_world[image.frameset]->conjugate());
+    }
+  }
+  return ConsensusRotation(candidates, problem.max_rotation_deviation);
+}
+
+// Assigns the pending estimates supported by two candidates if there are
+// any, else those supported by one: a wrong per-image pose always supports
+// the estimate made from it alone. Returns whether anything was assigned.
+bool AssignBySupport(
+    const std::vector<std::optional<RotationEstimate>>& pending,
+    std::vector<std::optional<Eigen::Quaterniond>>* rotations) {
+  int max_support = 0;
+  for (const std::optional<RotationEstimate>& estimate : pending) {
+    if (estimate) max_support = std::max(max_support, estimate->support);
+  }
+  const int min_support = std::clamp(max_support, 1, 2);
+  bool assigned = false;
+  for (size_t k = 0; k < pending.size(); ++k) {
+    if (pending[k] && pending[k]->support >= min_support) {
+      (*rotations)[k] = pending[k]->rotation;
+      assigned = true;
+    }
+  }
+  return assigned;
+}
+
+// The greedy back-and-forth assignment of one RANSAC trial, on rotations.
+// With radial poses every image's rotation is complete (its third row is the
+// cross product of the first two), so one camera with a rotation places a
+// frameset's rotation and one frameset places a camera's: frameset sets of
+// 2-3 cameras still connect the whole rig. The seed frameset places its
+// cameras relative to a base camera (the reference camera if there), whose
+// frame is the hypothesis' rig frame. After the greedy pass, two sweeps
+// re-estimate every rotation from all the others, which repairs early
+// choices made on little support.
+Rotations AssignRotationsGreedily(const InitProblem& problem, int seed_frameset,
+                                  int* base_camera) {
+  Rotations rotations;
+  rotations.cam_from_rig.resize(problem.num_cameras);
+  rotations.rig_from_world.resize(problem.num_framesets);
+  const std::vector<int>& seed_images =
+      problem.images_of_frameset[seed_frameset];
+  int base = seed_images.front();
+  for (const int index : seed_images) {
+    if (problem.images[index].camera == problem.reference_camera) base = index;
+  }
+  *base_camera = problem.images[base].camera;
+  const Eigen::Quaterniond seed_rotation =
+      problem.images[base].cam_from_world.rotation;
+  rotations.rig_from_world[seed_frameset] = seed_rotation;
+  for (const int index : seed_images) {
+    const LocalizedImage& image = problem.images[index];
+    rotations.cam_from_rig[image.camera] =
+        image.cam_from_world.rotation * seed_rotation.conjugate();
+  }
+
+  std::vector<std::optional<RotationEstimate>> pending_framesets(
+      problem.num_framesets);
+  std::vector<std::optional<RotationEstimate>> pending_cameras(
+      problem.num_cameras);
+  bool changed = true;
+  while (changed) {
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      pending_framesets[j] = rotations.rig_from_world[j]
+                                 ? std::nullopt
+                                 : FramesetRotation(problem, rotations, j);
+    }
+    changed = AssignBySupport(pending_framesets, &rotations.rig_from_world);
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      pending_cameras[i] = rotations.cam_from_rig[i]
+                               ? std::nullopt
+                               : CameraRotation(problem, rotations, i);
+    }
+    changed =
+        AssignBySupport(pending_cameras, &rotations.cam_from_rig) || changed;
+  }
+
+  for (int sweep = 0; sweep < kNumRotationSweeps; ++sweep) {
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      if (rotations.rig_from_world[j]) {
+        pending_framesets[j] = FramesetRotation(problem, rotations, j);
+      }
+    }
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      if (rotations.rig_from_world[j]) {
+        rotations.rig_from_world[j] = pending_framesets[j]->rotation;
+      }
+    }
+#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      if (rotations.cam_from_rig[i] && i != *base_camera) {
+        pending_cameras[i] = CameraRotation(problem, rotations, i);
+      }
+    }
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      if (rotations.cam_from_rig[i] && i != *base_camera) {
+        rotations.cam_from_rig[i] = pending_cameras[i]->rotation;
+      }
+    }
+  }
+  return rotations;
+}
+
+// Images, framesets and cameras whose poses the given images determine:
+// framesets with two of them from cameras with non-parallel axes when
+// radial (one when full), cameras with min_images_per_camera of them in
+// such framesets; repeated until stable, because dropping a camera can
+// undetermine a frameset.
+struct DeterminedParts {
+  std::vector<char> images;
+  std::vector<char> framesets;
+  std::vector<char> cameras;
+};
+
+DeterminedParts FindDeterminedParts(
+    const InitProblem& problem,
+    const std::vector<std::optional<Eigen::Quaterniond>>& cam_from_rig,
+    const std::vector<char>& usable_images, int min_images_per_camera) {
+  DeterminedParts parts;
+  parts.images = usable_images;
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    parts.images[k] = parts.images[k] && cam_from_rig[problem.images[k].camera];
+  }
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    parts.framesets.assign(problem.num_framesets, 0);
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      std::vector<Eigen::Vector3d> axes;
+      for (const int index : problem.images_of_frameset[j]) {
+        if (parts.images[index]) {
+          axes.push_back(cam_from_rig[problem.images[index].camera]
+                             ->toRotationMatrix()
+                             .row(2)
+                             .transpose());
+        }
+      }
+      parts.framesets[j] =
+          problem.num_rows == 2
+              ? axes.size() >= 2 &&
+                    SmallestAxisEigenvalue(axes) >= problem.min_axis_eigenvalue
+              : !axes.empty();
+    }
+    std::vector<int> num_camera_images(problem.num_cameras, 0);
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      if (parts.images[k] && parts.framesets[problem.images[k].frameset]) {
+        ++num_camera_images[problem.images[k].camera];
+      }
+    }
+    parts.cameras.assign(problem.num_cameras, 0);
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      parts.cameras[i] = num_camera_images[i] >= min_images_per_camera;
+    }
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      const LocalizedImage& image = problem.images[k];
+      if (parts.images[k] &&
+          !(parts.framesets[image.frameset] && parts.cameras[image.camera])) {
+        parts.images[k] = 0;
+        changed = true;
+      }
+    }
+  }
+  return parts;
+}
+
+// The translations' least-squares problem after eliminating the framesets'
+// t_Q: reduced * t_P = reduced_rhs over the t_P of the non-anchor cameras.
+struct ReducedTranslationSystem {
+  std::vector<int> unknown_of_camera;  // offset into t_P, -1: anchor/unused
+  std::vector<Eigen::MatrixXd> known_rows;  // per camera, rows of R_P
+  Eigen::MatrixXd reduced;
+  Eigen::VectorXd reduced_rhs;
+  // Per frameset: H_j = sum_i A_i^T A_i and sum_i A_i^T b_ij.
+  std::vector<Eigen::Matrix3d> frameset_normal;
+  std::vector<Eigen::Vector3d> frameset_rhs;
+};
+
+// Given the rotations, the known translation rows are linear in the
+// unknowns: per used image (camera i, frameset j), with A_i the known rows of
+// R_P and b_ij those of t_T,
+//   A_i t_Q,j + t_P,i = b_ij   (t_P,i: the known rows of camera i's t).
+// Eliminating t_Q,j = H_j^-1 (sum_i A_i^T (b_ij - t_P,i)) leaves, per pair of
+// images (i, k) of a frameset, delta_ik I - A_i H_j^-1 A_k^T, and right-hand
+// side b_ij - A_i H_j^-1 sum_k A_k^T b_kj. Gauge: the anchor camera's
+// t_P = 0 and, when radial, the slide of the rig origin along the anchor's
+// axis z (t_P,i += d (R_P,i z)_xy for all i) is fixed by
+// sum_i v_i^T t_P,i = 0 with v_i = (R_P,i z)_xy.
+ReducedTranslationSystem BuildReducedTranslationSystem(
+    const InitProblem& problem, const Rotations& rotations,
+    const DeterminedParts& parts, int anchor_camera) {
+  const int rows = problem.num_rows;
+  ReducedTranslationSystem system;
+  system.unknown_of_camera.assign(problem.num_cameras, -1);
+  system.known_rows.resize(problem.num_cameras);
+  int num_unknowns = 0;
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (!parts.cameras[i]) continue;
+    system.known_rows[i] =
+        rotations.cam_from_rig[i]->toRotationMatrix().topRows(rows);
+    if (i != anchor_camera) {
+      system.unknown_of_camera[i] = num_unknowns;
+      num_unknowns += rows;
+    }
+  }
+  system.reduced = Eigen::MatrixXd::Zero(num_unknowns, num_unknowns);
+  system.reduced_rhs = Eigen::VectorXd::Zero(num_unknowns);
+  system.frameset_normal.assign(problem.num_framesets, Eigen::Matrix3d::Zero());
+  system.frameset_rhs.assign(problem.num_framesets, Eigen::Vector3d::Zero());
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (!parts.framesets[j]) continue;
+    std::vector<int> used;
+    for (const int index : problem.images_of_frameset[j]) {
+      if (!parts.images[index]) continue;
+      const LocalizedImage& image = problem.images[index];
+      const Eigen::MatrixXd& a = system.known_rows[image.camera];
+      system.frameset_normal[j] += a.transpose() * a;
+      system.frameset_rhs[j] +=
+          a.transpose() * image.cam_from_world.translation.head(rows);
+      used.push_back(index);
+    }
+    const Eigen::Matrix3d inverse = system.frameset_normal[j].inverse();
+    for (const int index : used) {
+      const LocalizedImage& image = problem.images[index];
+      const int u = system.unknown_of_camera[image.camera];
+      if (u < 0) continue;
+      const Eigen::MatrixXd a_inverse =
+          system.known_rows[image.camera] * inverse;
+      system.reduced_rhs.segment(u, rows) +=
+          image.cam_from_world.translation.head(rows) -
+          a_inverse * system.frameset_rhs[j];
+      system.reduced.block(u, u, rows, rows) +=
+          Eigen::MatrixXd::Identity(rows, rows);
+      for (const int other : used) {
+        const int camera = problem.images[other].camera;
+        const int v = system.unknown_of_camera[camera];
+        if (v >= 0) {
+          system.reduced.block(u, v, rows, rows) -=
+              a_inverse * system.known_rows[camera].transpose();
+        }
+      }
+    }
+  }
+  if (rows == 2 && num_unknowns > 0) {
+    const Eigen::Vector3d anchor_axis =
+        rotations.cam_from_rig[anchor_camera]->toRotationMatrix().row(2);
+    Eigen::VectorXd slide = Eigen::VectorXd::Zero(num_unknowns);
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      const int u = system.unknown_of_camera[i];
+      if (u >= 0) slide.segment<2>(u) = system.known_rows[i] * anchor_axis;
+    }
+    system.reduced += slide * slide.transpose();
+  }
+  return system;
+}
+
+// Translations by least squares over the usable images jointly (see
+// BuildReducedTranslationSystem), so that each camera draws on every
+// frameset it shares with any other camera. Some directions may still be
+// undetermined although every frameset is: e.g. a radial camera only ever
+// seen with one other camera can slide along that camera's axis. Those are
+// the eigenvectors of the reduced matrix with eigenvalues below
+// min_axis_eigenvalue / 2 (the matrix is dimensionless; one frameset with two
+// cameras at the minimum angle contributes about min_axis_eigenvalue); their
+// cameras are dropped and the rest solved again.
+Hypothesis SolveTranslations(const InitProblem& problem,
+                             const Rotations& rotations,
+                             const std::vector<char>& usable_images,
+                             int preferred_anchor) {
+  Hypothesis hypothesis;
+  hypothesis.cam_from_rig.resize(problem.num_cameras);
+  hypothesis.rig_from_world.resize(problem.num_framesets);
+  std::vector<char> usable = usable_images;
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    usable[k] =
+        usable[k] &&
+        rotations.rig_from_world[problem.images[k].frameset].has_value();
+  }
+  while (true) {
+    const DeterminedParts parts =
+        FindDeterminedParts(problem, rotations.cam_from_rig, usable, 1);
+    int anchor = preferred_anchor;
+    if (!parts.cameras[anchor]) {
+      anchor = std::find(parts.cameras.begin(), parts.cameras.end(), 1) -
+               parts.cameras.begin();
+      if (anchor == problem.num_cameras) return hypothesis;
+    }
+    const ReducedTranslationSystem system =
+        BuildReducedTranslationSystem(problem, rotations, parts, anchor);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(system.reduced);
+    std::vector<char> undetermined(problem.num_cameras, 0);
+    bool any_undetermined = false;
+    for (int e = 0; e < system.reduced.rows(); ++e) {
+      if (eigen.eigenvalues()(e) >= 0.5 * problem.min_axis_eigenvalue) break;
+      for (int i = 0; i < problem.num_cameras; ++i) {
+        const int u = system.unknown_of_camera[i];
+        if (u >= 0 &&
+            eigen.eigenvectors().col(e).segment(u, problem.num_rows).norm() >
+                kUndeterminedComponent) {
+          undetermined[i] = 1;
+          any_undetermined = true;
+        }
+      }
+    }
+    if (any_undetermined) {
+      for (size_t k = 0; k < problem.images.size(); ++k) {
+        if (undetermined[problem.images[k].camera]) usable[k] = 0;
+      }
+      continue;
+    }
+
+    const Eigen::VectorXd translations =
+        eigen.eigenvectors() *
+        (eigen.eigenvectors().transpose() * system.reduced_rhs)
+            .cwiseQuotient(eigen.eigenvalues());
+    for (int i = 0; i < problem.num_cameras; ++i) {
+      if (!parts.cameras[i]) continue;
+      Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+      const int u = system.unknown_of_camera[i];
+      if (u >= 0) {
+        translation.head(problem.num_rows) =
+            translations.segment(u, problem.num_rows);
+      }
+      hypothesis.cam_from_rig[i] =
+          Rigid3d(*rotations.cam_from_rig[i], translation);
+    }
+    for (int j = 0; j < problem.num_framesets; ++j) {
+      if (!parts.framesets[j]) continue;
+      Eigen::Vector3d rhs = system.frameset_rhs[j];
+      for (const int index : problem.images_of_frameset[j]) {
+        const int camera = problem.images[index].camera;
+        if (parts.images[index]) {
+          rhs -= system.known_rows[camera].transpose() *
+                 hypothesis.cam_from_rig[camera]->translation.head(
+                     problem.num_rows);
+        }
+      }
+      hypothesis.rig_from_world[j] =
+          Rigid3d(*rotations.rig_from_world[j],
+                  system.frameset_normal[j].ldlt().solve(rhs));
+    }
+    return hypothesis;
+  }
+}
+
+// One RANSAC hypothesis: rotations by greedy assignment, then translations
+// by least squares over the images whose rotation agrees with the rig, then
+// again over those of them whose correspondences agree with the rig too (a
+// per-image pose with a right rotation and a wrong translation).
+Hypothesis MakeHypothesis(const InitProblem& problem, int seed_frameset) {
+  int base_camera = 0;
+  const Rotations rotations =
+      AssignRotationsGreedily(problem, seed_frameset, &base_camera);
+  std::vector<char> usable(problem.images.size(), 0);
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    const LocalizedImage& image = problem.images[k];
+    usable[k] = rotations.cam_from_rig[image.camera] &&
+                rotations.rig_from_world[image.frameset] &&
+                AngleRad(*rotations.cam_from_rig[image.camera] *
+                             *rotations.rig_from_world[image.frameset],
+                         image.cam_from_world.rotation) <
+                    problem.max_rotation_deviation;
+  }
+  Hypothesis hypothesis =
+      SolveTranslations(problem, rotations, usable, base_camera);
+  const std::vector<char> agree =
+      AgreeingImages(problem, FitHypothesis(problem, hypothesis));
+  std::vector<char> agreeing_usable(problem.images.size(), 0);
+  for (size_t k = 0; k < problem.images.size(); ++k) {
+    agreeing_usable[k] = usable[k] && agree[k];
+  }
+  if (agreeing_usable != usable) {
+    hypothesis =
+        SolveTranslations(problem, rotations, agreeing_usable, base_camera);
+  }
+  return hypothesis;
 }
 
 // Rigid3d <-> (angle-axis, translation) parameter blocks for Ceres.
@@ -514,7 +766,9 @@ void MinimizePoseDeviation(const InitProblem& problem,
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   solver_options.linear_solver_ordering.reset(ordering);
   solver_options.max_num_iterations = 100;
-  solver_options.num_threads = problem.num_threads;
+  // One thread: the Schur elimination accumulates in thread order, which
+  // would make the result vary in the last bits; the problem is small.
+  solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary solver_summary;
   ceres::Solve(solver_options, &ceres_problem, &solver_summary);
@@ -553,61 +807,29 @@ void ExpressInReferenceFrame(const InitProblem& problem,
   }
 }
 
-// Which images, cameras and rig poses the final rig keeps: images that agree
-// with the hypothesis, framesets they determine (radial: two of them with
-// non-parallel axes), cameras with two such images in kept framesets;
-// repeated until stable because dropping a camera can undetermine a
-// frameset. Unkept cameras and framesets are unassigned in the hypothesis.
+// Which images, cameras and rig poses the final rig keeps: the images that
+// agree with the hypothesis, the framesets they determine, the cameras with
+// two of them in such framesets (FindDeterminedParts). The others are
+// unassigned in the hypothesis.
 std::vector<char> KeepDeterminedParts(const InitProblem& problem,
                                       const std::vector<char>& agree,
                                       Hypothesis* hypothesis) {
-  std::vector<char> used = agree;
-  bool changed = true;
-  while (changed) {
-    changed = false;
-    std::vector<char> kept_frameset(problem.num_framesets, 0);
-    for (int j = 0; j < problem.num_framesets; ++j) {
-      std::vector<Eigen::Vector3d> axes;
-      for (const int index : problem.images_of_frameset[j]) {
-        if (used[index]) {
-          axes.push_back(PrincipalAxis(
-              *hypothesis->cam_from_rig[problem.images[index].camera]));
-        }
-      }
-      kept_frameset[j] =
-          problem.num_rows == 2
-              ? axes.size() >= 2 &&
-                    SmallestAxisEigenvalue(axes) >= problem.min_axis_eigenvalue
-              : !axes.empty();
-    }
-    std::vector<int> num_camera_images(problem.num_cameras, 0);
-    for (size_t k = 0; k < problem.images.size(); ++k) {
-      if (used[k] && kept_frameset[problem.images[k].frameset]) {
-        ++num_camera_images[problem.images[k].camera];
-      }
-    }
-    std::vector<char> kept_camera(problem.num_cameras, 0);
-    for (int i = 0; i < problem.num_cameras; ++i) {
-      kept_camera[i] = num_camera_images[i] >= kMinAgreeingImagesPerCamera;
-    }
-    for (size_t k = 0; k < problem.images.size(); ++k) {
-      const LocalizedImage& image = problem.images[k];
-      if (used[k] &&
-          !(kept_frameset[image.frameset] && kept_camera[image.camera])) {
-        used[k] = 0;
-        changed = true;
-      }
-    }
-    if (!changed) {
-      for (int j = 0; j < problem.num_framesets; ++j) {
-        if (!kept_frameset[j]) hypothesis->rig_from_world[j].reset();
-      }
-      for (int i = 0; i < problem.num_cameras; ++i) {
-        if (!kept_camera[i]) hypothesis->cam_from_rig[i].reset();
-      }
+  std::vector<std::optional<Eigen::Quaterniond>> cam_rotations(
+      problem.num_cameras);
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (hypothesis->cam_from_rig[i]) {
+      cam_rotations[i] = hypothesis->cam_from_rig[i]->rotation;
     }
   }
-  return used;
+  const DeterminedParts parts = FindDeterminedParts(
+      problem, cam_rotations, agree, kMinAgreeingImagesPerCamera);
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (!parts.framesets[j]) hypothesis->rig_from_world[j].reset();
+  }
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (!parts.cameras[i]) hypothesis->cam_from_rig[i].reset();
+  }
+  return parts.images;
 }
 
 bool Fail(const std::string& message, RigInitializerSummary* summary) {
@@ -629,6 +851,8 @@ std::string BuildProblem(const RigInitializerOptions& options,
   problem->num_rows = options.radial ? 2 : 3;
   problem->min_axis_eigenvalue =
       1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
+  problem->max_rotation_deviation =
+      options.max_rotation_deviation_deg * M_PI / 180.0;
   problem->num_threads = colmap::GetEffectiveNumThreads(options.num_threads);
   problem->images_of_frameset.assign(problem->num_framesets, {});
   problem->images_of_camera.assign(problem->num_cameras, {});
@@ -642,10 +866,12 @@ std::string BuildProblem(const RigInitializerOptions& options,
     return error.str();
   }
   if (!(options.max_radial_error_px > 0) || !(options.loss_scale > 0) ||
+      !(options.max_rotation_deviation_deg > 0) ||
       !(options.translation_weight >= 0) || !(options.confidence > 0) ||
       !(options.confidence < 1) || options.max_num_trials < 1) {
-    return "invalid options: max_radial_error_px and loss_scale must be "
-           "positive, translation_weight non-negative, confidence in (0, 1), "
+    return "invalid options: max_radial_error_px, loss_scale and "
+           "max_rotation_deviation_deg must be positive, translation_weight "
+           "non-negative, confidence in (0, 1), "
            "max_num_trials >= 1";
   }
   if (calibration.images.size() != dataset.images.size()) {
@@ -773,7 +999,7 @@ bool InitializeRig(const RigInitializerOptions& options,
   const int max_trials =
       std::min<int>(options.max_num_trials, static_cast<int>(seeds.size()));
   while (num_trials < max_trials && num_trials < required_trials) {
-    Hypothesis hypothesis = AssignGreedily(problem, seeds[num_trials]);
+    Hypothesis hypothesis = MakeHypothesis(problem, seeds[num_trials]);
     ++num_trials;
     const std::vector<std::optional<ImageFit>> fits =
         FitHypothesis(problem, hypothesis);

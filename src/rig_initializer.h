@@ -42,6 +42,10 @@ struct RigInitializerOptions {
   double confidence = 0.999;
   // Truncation of the robust radial reprojection score, pixels.
   double max_radial_error_px = 8.0;
+  // In the greedy assignment, a per-image rotation within this angle of
+  // R_P R_Q supports the hypothesis (wrong per-image poses are random; the
+  // radial score judges what remains).
+  double max_rotation_deviation_deg = 5.0;
   // Cauchy scale of the local optimization of eq. 4, in the units of
   // d(T, P Q): rotation difference in radians, plus translation_weight times
   // the translation difference in map units (first two rows when radial).
@@ -85,20 +89,27 @@ struct RigInitializerSummary {
 // images) and calibration->camera_calibrated (false for cameras that could
 // not be placed; their cam_from_rig is the identity).
 //
-// Per trial: a random seed frameset with >= 2 localized images gives the P_i
-// of its cameras relative to one of them. Then, alternately, the Q_j of
-// framesets with assigned cameras are solved (Procrustes on the stacked known
-// rows, least squares for the translation; radial rigs need two cameras with
-// non-parallel axes; with more images than needed the leave-one-out
-// solutions compete) and kept if two of the frameset's images agree with
-// them (one for full poses), and unassigned P_i = T_ij Q_j^-1 are taken from
-// the frameset whose candidate most of camera i's images agree with, cameras
-// confirmed by two images first. An image agrees with a pose if both its own
-// pose and that pose put >= 5 of its scored inliers within
-// max_radial_error_px and neither explains less than half of what the other
-// does. The best hypothesis by radial score keeps its agreeing images, the
-// framesets they determine and the cameras with two of them; eq. 4 is
-// minimized over those.
+// Per trial (the greedy back-and-forth assignment):
+//  1. Rotations. A random seed frameset with >= 2 localized images gives the
+//     rotations of its cameras relative to one of them; then, alternately,
+//     framesets seen by cameras with a rotation get R_Q and cameras seen in
+//     framesets with a rotation get R_P, each as the chordal mean of the
+//     candidates (R_P^T R_T, resp. R_T R_Q^T) that agree with the
+//     best-supported one; estimates supported by two images go first, and
+//     two sweeps re-estimate everything at the end. A radial pose's rotation
+//     is complete, so one shared camera links a frameset: partial framesets
+//     of 2-3 cameras still connect the rig.
+//  2. Translations. Eq. 3's observable rows, A_i t_Q + t_P,i = b_ij, are
+//     linear once the rotations are known; they are solved jointly by least
+//     squares over all images whose rotation agrees with the rig (each
+//     frameset's t_Q eliminated by Schur complement; radial rigs need two
+//     cameras with non-parallel axes per frameset), and once more over those
+//     whose correspondences agree with the result.
+// An image agrees with a pose if both its own pose and that pose put >= 5 of
+// its scored inliers within max_radial_error_px and neither explains less
+// than half of what the other does. The hypothesis with the best truncated
+// radial score keeps its agreeing images, the framesets they determine and
+// the cameras with two of them; eq. 4 is minimized over those.
 //
 // Returns false (message in summary->message and the log) on inconsistent
 // input, on radial rigs with parallel principal axes, or if the reference

@@ -24,9 +24,9 @@ Rigid3d Rigid3d::FromQvecTvec(const Eigen::Vector4d& qvec,
 }
 
 Rigid3d operator*(const Rigid3d& a_from_b, const Rigid3d& b_from_c) {
-  return Rigid3d(a_from_b.rotation * b_from_c.rotation,
-                 a_from_b.rotation * b_from_c.translation +
-                     a_from_b.translation);
+  return Rigid3d(
+      a_from_b.rotation * b_from_c.rotation,
+      a_from_b.rotation * b_from_c.translation + a_from_b.translation);
 }
 
 double RotationDifferenceDeg(const Eigen::Quaterniond& a,
@@ -42,7 +42,8 @@ Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(
       matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() > 0 ? 1 : -1;
+  d(2, 2) =
+      (svd.matrixU() * svd.matrixV().transpose()).determinant() > 0 ? 1 : -1;
   return svd.matrixU() * d * svd.matrixV().transpose();
 }
 

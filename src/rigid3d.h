@@ -13,7 +13,8 @@ struct Rigid3d {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
 
   Rigid3d() = default;
-  Rigid3d(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation)
+  Rigid3d(const Eigen::Quaterniond& rotation,
+          const Eigen::Vector3d& translation)
       : rotation(rotation.normalized()), translation(translation) {}
   Rigid3d(const Eigen::Matrix3d& rotation_matrix,
           const Eigen::Vector3d& translation)

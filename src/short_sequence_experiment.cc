@@ -36,9 +36,8 @@ std::vector<ShortSequenceResult> RunShortSequenceExperiment(
   const SyntheticRig recording = GenerateSyntheticRig(options.recording);
   const int span =
       (options.framesets_per_sequence - 1) * options.frameset_stride + 1;
-  const int num_starts =
-      std::max(1, static_cast<int>(recording.dataset.frameset_names.size()) -
-                      span + 1);
+  const int num_starts = std::max(
+      1, static_cast<int>(recording.dataset.frameset_names.size()) - span + 1);
   std::mt19937 random(options.seed);
   std::uniform_int_distribution<int> start_distribution(0, num_starts - 1);
   std::vector<std::vector<int>> sequences(options.num_sequences);
@@ -102,10 +101,10 @@ std::string FormatShortSequenceResults(
            "|---|---|---|---|---|---|---|\n";
   for (const ShortSequenceResult& result : results) {
     table << "| " << CalibrationMethodName(result.method) << " | "
-          << result.num_sequences << " | " << std::fixed
-          << std::setprecision(0) << result.PercentComplete() << "% | "
-          << result.PercentGood() << "% | " << std::setprecision(3)
-          << Median(result.max_rotation_deg) << " | " << std::setprecision(2)
+          << result.num_sequences << " | " << std::fixed << std::setprecision(0)
+          << result.PercentComplete() << "% | " << result.PercentGood()
+          << "% | " << std::setprecision(3) << Median(result.max_rotation_deg)
+          << " | " << std::setprecision(2)
           << 100.0 * Median(result.max_center_error) << " | "
           << result.seconds / std::max(1, result.num_sequences) << " |\n";
   }

@@ -73,9 +73,8 @@ TEST(AtomicOutput, FolderAppearsWhole) {
   testing::ScopedTempDir dir;
   const std::string output = dir.File("out");
   std::string error;
-  ASSERT_TRUE(
-      WriteFolderAtomically(output, OutputFolderOptions(), WriteTwoFiles,
-                            &error))
+  ASSERT_TRUE(WriteFolderAtomically(output, OutputFolderOptions(),
+                                    WriteTwoFiles, &error))
       << error;
   EXPECT_EQ(ReadFile(output + "/a.txt"), "a");
   EXPECT_EQ(ReadFile(output + "/b.txt"), "b");
@@ -95,8 +94,8 @@ TEST(AtomicOutput, FolderAppearsWhole) {
 
   // A file in the way, or a missing parent folder.
   std::ofstream(dir.File("file")) << "x";
-  EXPECT_FALSE(WriteFolderAtomically(dir.File("file"), overwrite,
-                                     WriteTwoFiles, &error));
+  EXPECT_FALSE(WriteFolderAtomically(dir.File("file"), overwrite, WriteTwoFiles,
+                                     &error));
   EXPECT_NE(error.find("is not a folder"), std::string::npos);
   EXPECT_FALSE(WriteFolderAtomically(dir.File("no/out"), overwrite,
                                      WriteTwoFiles, &error));
@@ -114,8 +113,7 @@ TEST(AtomicOutput, OutputMustNotOverlapInputs) {
        {dir.File("map/sparse/0"), dir.File("map/sparse/0/"),
         dir.File("map/sparse/0/out"), dir.File("map"),
         dir.File("images/../map/sparse")}) {
-    EXPECT_FALSE(
-        WriteFolderAtomically(output, options, WriteTwoFiles, &error))
+    EXPECT_FALSE(WriteFolderAtomically(output, options, WriteTwoFiles, &error))
         << output;
     EXPECT_NE(error.find("overlaps the input path"), std::string::npos);
   }

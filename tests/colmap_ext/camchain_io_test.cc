@@ -35,8 +35,8 @@ double MaxProjectionDifference(const colmap::Camera& a,
                                   0.5 + (a.Height() - 1.0) * iy / 10);
       const Eigen::Vector2d world = a.ImageToWorld(pixel);
       max_difference =
-          std::max(max_difference, (a.WorldToImage(world) -
-                                    b.WorldToImage(world)).norm());
+          std::max(max_difference,
+                   (a.WorldToImage(world) - b.WorldToImage(world)).norm());
     }
   }
   return max_difference;
@@ -44,10 +44,10 @@ double MaxProjectionDifference(const colmap::Camera& a,
 
 Rigid3d RandomPose(std::mt19937* random) {
   std::normal_distribution<double> normal;
-  return Rigid3d(Eigen::Quaterniond(normal(*random), normal(*random),
-                                    normal(*random), normal(*random)),
-                 Eigen::Vector3d(normal(*random), normal(*random),
-                                 normal(*random)));
+  return Rigid3d(
+      Eigen::Quaterniond(normal(*random), normal(*random), normal(*random),
+                         normal(*random)),
+      Eigen::Vector3d(normal(*random), normal(*random), normal(*random)));
 }
 
 TEST(CamchainIo, EveryColmapModelConverts) {
@@ -71,8 +71,10 @@ TEST(CamchainIo, EveryColmapModelConverts) {
        {500, 510, 320, 240, -0.1, 0.02, 1e-3, -2e-3, 0.003, 0.001, 0, 0},
        "radtan",
        false},
-      {"OPENCV_FISHEYE", {300, 310, 320, 240, 0.05, -0.01, 0.002, -1e-4},
-       "equidistant", true},
+      {"OPENCV_FISHEYE",
+       {300, 310, 320, 240, 0.05, -0.01, 0.002, -1e-4},
+       "equidistant",
+       true},
       {"SIMPLE_RADIAL_FISHEYE", {300, 320, 240, 0.05}, "equidistant", true},
       {"RADIAL_FISHEYE", {300, 320, 240, 0.05, -0.01}, "equidistant", true},
       {"FOV", {400, 410, 320, 240, 0.9}, "fov", true},
@@ -118,10 +120,10 @@ TEST(CamchainIo, RoundTripThroughFile) {
   RigDescription rig;
   rig.cameras.resize(4);
   const std::vector<colmap::Camera> cameras = {
-      MakeCamera("OPENCV_FISHEYE", {300, 310, 320.25, 240.75, 0.05, -0.01,
-                                    0.002, -1e-4}),
-      MakeCamera("OPENCV", {500, 510, 330, 250, -0.1, 0.02, 1e-3, -2e-3},
-                 752, 480),
+      MakeCamera("OPENCV_FISHEYE",
+                 {300, 310, 320.25, 240.75, 0.05, -0.01, 0.002, -1e-4}),
+      MakeCamera("OPENCV", {500, 510, 330, 250, -0.1, 0.02, 1e-3, -2e-3}, 752,
+                 480),
       MakeCamera("FOV", {400, 410, 320, 240, 0.9}),
       MakeCamera("PINHOLE", {500, 500, 320, 240})};
   for (int c = 0; c < 4; ++c) {
@@ -159,8 +161,8 @@ TEST(CamchainIo, RoundTripThroughFile) {
       t(r, k) = root["cam2"]["T_cn_cnm1"][r][k].as<double>();
     }
   }
-  const Rigid3d expected = *rig.cameras[3].cam_from_rig *
-                           rig.cameras[1].cam_from_rig->Inverse();
+  const Rigid3d expected =
+      *rig.cameras[3].cam_from_rig * rig.cameras[1].cam_from_rig->Inverse();
   EXPECT_LT((t.topRows<3>() - expected.ToMatrix()).norm(), 1e-12);
 
   RigDescription read;
@@ -173,9 +175,9 @@ TEST(CamchainIo, RoundTripThroughFile) {
     EXPECT_EQ(read.cameras[i].name, "cam" + std::to_string(i));
     ASSERT_TRUE(read.cameras[i].camera && read.cameras[i].cam_from_rig);
     EXPECT_EQ(read.cameras[i].camera->Width(), original.camera->Width());
-    EXPECT_LT(MaxProjectionDifference(*original.camera,
-                                      *read.cameras[i].camera),
-              1e-9);
+    EXPECT_LT(
+        MaxProjectionDifference(*original.camera, *read.cameras[i].camera),
+        1e-9);
     EXPECT_NEAR(read.cameras[i].camera->PrincipalPointX(),
                 original.camera->PrincipalPointX(), 1e-12);
     // The rig frame is cam0's, which is the original reference.

@@ -60,8 +60,7 @@ TEST(CorrespondenceIo, RoundTripIsBitExact) {
     EXPECT_EQ(read[i].image_name, images[i].image_name);
     EXPECT_EQ(read[i].width, 640);
     EXPECT_EQ(read[i].height, 480);
-    ASSERT_EQ(read[i].correspondences.size(),
-              images[i].correspondences.size());
+    ASSERT_EQ(read[i].correspondences.size(), images[i].correspondences.size());
     for (size_t k = 0; k < images[i].correspondences.size(); ++k) {
       const Correspondence& a = images[i].correspondences[k];
       const Correspondence& b = read[i].correspondences[k];
@@ -93,7 +92,8 @@ TEST(CorrespondenceIo, ReadsTheDesignExample) {
   ASSERT_TRUE(ReadCorrespondenceFile(path, &images, &error)) << error;
   ASSERT_EQ(images.size(), 1u);
   ASSERT_EQ(images[0].correspondences.size(), 2u);
-  EXPECT_EQ(images[0].correspondences[0].point2D, Eigen::Vector2d(312.41, 220.13));
+  EXPECT_EQ(images[0].correspondences[0].point2D,
+            Eigen::Vector2d(312.41, 220.13));
   EXPECT_EQ(images[0].correspondences[0].point3D,
             Eigen::Vector3d(1.234, -0.55, 4.21));
   EXPECT_EQ(images[0].correspondences[0].point3D_id, 1234);
@@ -104,37 +104,45 @@ TEST(CorrespondenceIo, MalformedFilesGiveLineNumbers) {
   testing::ScopedTempDir dir;
   const std::string path = dir.File("bad.txt");
   const std::string header = "# header\nIMAGE a.png 640 480 2\n";
-  EXPECT_EQ(ReadError(path, header + "1 2 3 4\n5 6 7 8 9\n"),
-            "file " + path + " line 3: expected 5 or 6 numbers, found 4 fields");
+  EXPECT_EQ(
+      ReadError(path, header + "1 2 3 4\n5 6 7 8 9\n"),
+      "file " + path + " line 3: expected 5 or 6 numbers, found 4 fields");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5\n1 2 x 4 5\n"),
             "file " + path + " line 4: field 3 'x' is not a finite number");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5\n1 2 nan 4 5\n"),
             "file " + path + " line 4: field 3 'nan' is not a finite number");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5 6.5\n"),
-            "file " + path + " line 3: the point3D_id '6.5' is not an integer "
-                             ">= -1");
+            "file " + path +
+                " line 3: the point3D_id '6.5' is not an integer "
+                ">= -1");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5\n"),
-            "file " + path + " line 3: the file ends but image a.png (line 2) "
-                             "declares 2 rows");
+            "file " + path +
+                " line 3: the file ends but image a.png (line 2) "
+                "declares 2 rows");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5\nIMAGE b.png 1 1 0\n"),
-            "file " + path + " line 4: image a.png (line 2) declares 2 rows "
-                             "but has only 1");
+            "file " + path +
+                " line 4: image a.png (line 2) declares 2 rows "
+                "but has only 1");
   EXPECT_EQ(ReadError(path, header + "1 2 3 4 5\n1 2 3 4 5\n1 2 3 4 5\n"),
-            "file " + path + " line 5: image a.png (line 2) declares 2 rows, "
-                             "but there are more");
+            "file " + path +
+                " line 5: image a.png (line 2) declares 2 rows, "
+                "but there are more");
   EXPECT_EQ(ReadError(path, "1 2 3 4 5\n"),
-            "file " + path + " line 1: expected an IMAGE line before the "
-                             "first row");
+            "file " + path +
+                " line 1: expected an IMAGE line before the "
+                "first row");
   EXPECT_EQ(ReadError(path, "IMAGE a.png 640 0 0\n"),
             "file " + path + " line 1: the image size must be positive");
   EXPECT_EQ(ReadError(path, "IMAGE a.png 640 480\n"),
-            "file " + path + " line 1: expected IMAGE <image_name> <width> "
-                             "<height> <num_rows>");
+            "file " + path +
+                " line 1: expected IMAGE <image_name> <width> "
+                "<height> <num_rows>");
   EXPECT_EQ(ReadError(path, "IMAGE a.png 640 480 0\nIMAGE a.png 640 480 0\n"),
             "file " + path + " line 2: the image a.png appears twice");
   std::vector<ImageCorrespondences> images;
   std::string error;
-  EXPECT_FALSE(ReadCorrespondenceFile(dir.File("missing.txt"), &images, &error));
+  EXPECT_FALSE(
+      ReadCorrespondenceFile(dir.File("missing.txt"), &images, &error));
 }
 
 TEST(CorrespondenceIo, RefusesUnwritableNamesAndKeepsOldFile) {

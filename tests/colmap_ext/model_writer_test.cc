@@ -32,7 +32,8 @@ colmap::Camera MakeCamera(const std::string& model,
   return camera;
 }
 
-Eigen::Vector2d Project(const colmap::Camera& camera, const Rigid3d& cam_from_world,
+Eigen::Vector2d Project(const colmap::Camera& camera,
+                        const Rigid3d& cam_from_world,
                         const Eigen::Vector3d& point) {
   const Eigen::Vector3d x = cam_from_world * point;
   return camera.WorldToImage(x.hnormalized());
@@ -56,7 +57,7 @@ struct Scene {
   colmap::Reconstruction map;
   RigDataset dataset;
   RigCalibration calibration;
-  int num_registered = 0;  // rig images expected in the model
+  int num_registered = 0;    // rig images expected in the model
   int num_observations = 0;  // rig observations expected in the model
 };
 
@@ -114,8 +115,8 @@ Scene MakeScene() {
   dataset.reference_camera = 0;
   for (int f = 0; f < 4; ++f) {
     dataset.frameset_names.push_back(std::to_string(f) + ".png");
-    calibration.rig_from_world.push_back(
-        f == 3 ? std::optional<Rigid3d>() : SmallPose(&random, 0.1, 1.0));
+    calibration.rig_from_world.push_back(f == 3 ? std::optional<Rigid3d>()
+                                                : SmallPose(&random, 0.1, 1.0));
   }
   for (int f = 0; f < 4; ++f) {
     for (int c = 0; c < 3; ++c) {
@@ -200,8 +201,8 @@ void ExpectFramesMatchImages(const colmap::Reconstruction& model,
           sensor_from_rig = sensor.sensor_from_rig;
         }
       }
-      ASSERT_TRUE(sensor_from_rig) << "camera " << data.sensor.id
-                                   << " is not a posed sensor of its rig";
+      ASSERT_TRUE(sensor_from_rig)
+          << "camera " << data.sensor.id << " is not a posed sensor of its rig";
       const colmap::Image& image = model.Image(data.data_id);
       EXPECT_EQ(image.CameraId(), data.sensor.id);
       const Rigid3d expected = *sensor_from_rig * frame.rig_from_world;
@@ -225,10 +226,10 @@ TEST(ModelWriter, BuildsTheModel) {
       << error;
   const colmap::Reconstruction& model = rig_model.model;
   EXPECT_EQ(model.NumCameras(), 4u);
-  EXPECT_EQ(rig_model.rig.camera_ids,
-            (std::vector<colmap::camera_t>{2, 3, 4}));
+  EXPECT_EQ(rig_model.rig.camera_ids, (std::vector<colmap::camera_t>{2, 3, 4}));
   EXPECT_EQ(model.NumRegImages(), 2u + scene.num_registered);
-  EXPECT_EQ(NumObservations(model), 2u * kNumMapPoints + scene.num_observations);
+  EXPECT_EQ(NumObservations(model),
+            2u * kNumMapPoints + scene.num_observations);
   EXPECT_EQ(rig_model.rig.frames.size(), 3u);
   for (size_t i = 0; i < scene.dataset.images.size(); ++i) {
     const RigImage& rig_image = scene.dataset.images[i];
@@ -251,7 +252,8 @@ TEST(ModelWriter, BuildsTheModel) {
     for (colmap::point2D_t k = 0; k < image.NumPoints2D(); ++k) {
       if (!image.Point2D(k).HasPoint3D()) continue;
       EXPECT_TRUE(scene.calibration.images[i].inlier_mask[k]);
-      const colmap::Point3D& point = model.Point3D(image.Point2D(k).Point3DId());
+      const colmap::Point3D& point =
+          model.Point3D(image.Point2D(k).Point3DId());
       EXPECT_LT((Project(model.Camera(image.CameraId()), actual, point.XYZ()) -
                  image.Point2D(k).XY())
                     .norm(),
@@ -259,9 +261,9 @@ TEST(ModelWriter, BuildsTheModel) {
     }
   }
   // The rig is expressed in the reference camera's frame.
-  EXPECT_LT((rig_model.rig.cam_from_rig[0]->ToMatrix() -
-             Rigid3d().ToMatrix()).norm(),
-            1e-15);
+  EXPECT_LT(
+      (rig_model.rig.cam_from_rig[0]->ToMatrix() - Rigid3d().ToMatrix()).norm(),
+      1e-15);
 }
 
 class ModelWriterOutput : public ::testing::TestWithParam<std::string> {};
@@ -272,8 +274,8 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
   const Scene scene = MakeScene();
   testing::ScopedTempDir dir;
   const std::string output = dir.File("out");
-  CalibrationSummary summary = SummarizeCalibration(
-      scene.dataset, scene.calibration, {});
+  CalibrationSummary summary =
+      SummarizeCalibration(scene.dataset, scene.calibration, {});
   summary.method = "1dr";
   summary.diagnostics.push_back("a diagnostic of the caller");
   summary.timings_s.emplace_back("localize", 1.5);
@@ -291,12 +293,12 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
   for (const auto& entry : fs::directory_iterator(output)) {
     files.insert(entry.path().filename().string());
   }
-  EXPECT_EQ(files, (std::set<std::string>{
-                       "cameras" + extension, "images" + extension,
-                       "points3D" + extension, "rigs" + extension,
-                       "frames" + extension, kRigConfigFile,
-                       kRigBundleAdjusterConfigFile, kCamchainFile,
-                       kSummaryFile, kCorrespondencesFile}));
+  EXPECT_EQ(files,
+            (std::set<std::string>{"cameras" + extension, "images" + extension,
+                                   "points3D" + extension, "rigs" + extension,
+                                   "frames" + extension, kRigConfigFile,
+                                   kRigBundleAdjusterConfigFile, kCamchainFile,
+                                   kSummaryFile, kCorrespondencesFile}));
   // No temporary folder is left next to the output.
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()),
                           fs::directory_iterator()),
@@ -357,12 +359,11 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
 
   // The exchange formats describe the same rig.
   std::vector<RigDescription> rig_config;
-  ASSERT_TRUE(ReadRigConfigJson(output + "/" + kRigConfigFile, &rig_config,
-                                &error))
+  ASSERT_TRUE(
+      ReadRigConfigJson(output + "/" + kRigConfigFile, &rig_config, &error))
       << error;
   RigDescription camchain;
-  ASSERT_TRUE(ReadCamchainYaml(output + "/" + kCamchainFile, &camchain,
-                               &error))
+  ASSERT_TRUE(ReadCamchainYaml(output + "/" + kCamchainFile, &camchain, &error))
       << error;
   ASSERT_EQ(rig_config.size(), 1u);
   ASSERT_EQ(camchain.cameras.size(), 3u);
@@ -411,10 +412,10 @@ TEST(ModelWriter, UncalibratedCameraHasNoPoseAndNoImages) {
   const std::string output = dir.File("out");
   std::vector<std::string> notes;
   std::string error;
-  ASSERT_TRUE(WriteRigOutput(
-      output, scene.map, scene.dataset, scene.calibration, {},
-      SummarizeCalibration(scene.dataset, scene.calibration, {}),
-      RigOutputOptions(), &notes, &error))
+  ASSERT_TRUE(
+      WriteRigOutput(output, scene.map, scene.dataset, scene.calibration, {},
+                     SummarizeCalibration(scene.dataset, scene.calibration, {}),
+                     RigOutputOptions(), &notes, &error))
       << error;
   colmap::Reconstruction model;
   model.Read(output);
@@ -436,9 +437,9 @@ TEST(ModelWriter, TimestampFramesetsAreNotedForColmapsRigTools) {
   testing::ScopedTempDir dir;
   std::vector<std::string> notes;
   std::string error;
-  ASSERT_TRUE(WriteRigOutput(
-      dir.File("out"), scene.map, scene.dataset, scene.calibration, {},
-      CalibrationSummary(), RigOutputOptions(), &notes, &error))
+  ASSERT_TRUE(WriteRigOutput(dir.File("out"), scene.map, scene.dataset,
+                             scene.calibration, {}, CalibrationSummary(),
+                             RigOutputOptions(), &notes, &error))
       << error;
   ASSERT_EQ(notes.size(), 2u);
   EXPECT_NE(notes[0].find("will see 2 snapshots with two images or more, "
@@ -527,8 +528,8 @@ TEST(ModelWriter, RejectsMismatchedCalibration) {
   EXPECT_NE(error.find("cam1 has invalid intrinsics"), std::string::npos);
   RigDataset map_name = scene.dataset;
   map_name.images[0].name = "map/1.png";
-  EXPECT_FALSE(BuildRigModel(scene.map, map_name, scene.calibration,
-                             &rig_model, &error));
+  EXPECT_FALSE(BuildRigModel(scene.map, map_name, scene.calibration, &rig_model,
+                             &error));
   EXPECT_NE(error.find("has the name of a map image"), std::string::npos);
 }
 

@@ -44,8 +44,8 @@ Points MakePoints(const RadialIntrinsics& model, const int num_points,
 }
 
 RadialIntrinsics MakeModel(const RadialProfile profile, const int num_terms,
-                           const double tz, const double focal,
-                           const double k1, const double k2) {
+                           const double tz, const double focal, const double k1,
+                           const double k2) {
   RadialIntrinsics model;
   model.profile = profile;
   model.num_radial_terms = num_terms;
@@ -78,16 +78,16 @@ TEST(RadialIntrinsics, ProjectMatchesColmapModels) {
     const double depth = point_cam.z() + 0.7;
     Eigen::Vector2d x, expected;
     ASSERT_TRUE(polynomial.Project(point_cam, &x));
-    colmap::CameraModelWorldToImage(
-        colmap::RadialCameraModel::kModelId, radial_params,
-        point_cam.x() / depth, point_cam.y() / depth, &expected.x(),
-        &expected.y());
+    colmap::CameraModelWorldToImage(colmap::RadialCameraModel::kModelId,
+                                    radial_params, point_cam.x() / depth,
+                                    point_cam.y() / depth, &expected.x(),
+                                    &expected.y());
     EXPECT_LT((x - expected).norm(), 1e-9);
     ASSERT_TRUE(equidistant.Project(point_cam, &x));
-    colmap::CameraModelWorldToImage(
-        colmap::RadialFisheyeCameraModel::kModelId, fisheye_params,
-        point_cam.x() / depth, point_cam.y() / depth, &expected.x(),
-        &expected.y());
+    colmap::CameraModelWorldToImage(colmap::RadialFisheyeCameraModel::kModelId,
+                                    fisheye_params, point_cam.x() / depth,
+                                    point_cam.y() / depth, &expected.x(),
+                                    &expected.y());
     EXPECT_LT((x - expected).norm(), 1e-9);
   }
   Eigen::Vector2d x;
@@ -186,8 +186,9 @@ TEST(EstimateRadialIntrinsics, ExactDataMinimalAndOverdetermined) {
           profile == RadialProfile::kPolynomial
               ? MakeModel(profile, num_terms, -0.6, 500, -0.3, 0.08)
               : MakeModel(profile, num_terms, -0.6, 300, 0.03, -0.005);
+      // Within 45 degrees r_d = f q (1 - 0.3 q^2) still grows with q.
       const double max_angle_deg =
-          profile == RadialProfile::kPolynomial ? 50 : 75;
+          profile == RadialProfile::kPolynomial ? 45 : 75;
       int num_found = 0;
       for (int trial = 0; trial < kNumTrials; ++trial) {
         const Points minimal =
@@ -215,6 +216,28 @@ TEST(EstimateRadialIntrinsics, ExactDataMinimalAndOverdetermined) {
       ExpectNear(models[0], truth, 1e-8);
     }
   }
+}
+
+// Minimal samples of points on the wrong half-line of the radial pose fit
+// profiles whose radial factor turns negative, i.e. that mirror the points
+// through the principal point; such profiles are rejected.
+TEST(EstimateRadialIntrinsics, RejectsMirroringProfiles) {
+  const RadialIntrinsics truth =
+      MakeModel(RadialProfile::kPolynomial, 2, 0.4, 500, -0.3, 0.08);
+  int num_estimates = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Points points = MakePoints(truth, 4, 45, 200 + trial);
+    num_estimates += !EstimateRadialIntrinsics(points.x, points.points_cam,
+                                               RadialProfile::kPolynomial, 2)
+                          .empty();
+    for (Eigen::Vector3d& point : points.points_cam) {
+      point.head<2>() *= -1;
+    }
+    EXPECT_TRUE(EstimateRadialIntrinsics(points.x, points.points_cam,
+                                         RadialProfile::kPolynomial, 2)
+                    .empty());
+  }
+  EXPECT_EQ(num_estimates, 20);
 }
 
 TEST(EstimateRadialIntrinsics, NoisyData) {

@@ -132,8 +132,8 @@ TEST(Pipeline, KnownIntrinsicsAreKeptByKnownAndRefinedByKnownRefine) {
     SCOPED_TRACE(CalibrationMethodName(method));
     RigCalibration calibration;
     PipelineReport report;
-    ASSERT_TRUE(CalibrateRig(QuietOptions(method), rig.dataset, &calibration,
-                             &report))
+    ASSERT_TRUE(
+        CalibrateRig(QuietOptions(method), rig.dataset, &calibration, &report))
         << report.error;
     if (method == CalibrationMethod::kKnown) {
       for (size_t c = 0; c < rig.truth.cameras.size(); ++c) {
@@ -153,8 +153,8 @@ TEST(Pipeline, PerImageIntrinsicsMethodsCalibrateTheRing) {
     SCOPED_TRACE(CalibrationMethodName(method));
     RigCalibration calibration;
     PipelineReport report;
-    ASSERT_TRUE(CalibrateRig(QuietOptions(method), rig.dataset, &calibration,
-                             &report))
+    ASSERT_TRUE(
+        CalibrateRig(QuietOptions(method), rig.dataset, &calibration, &report))
         << report.error;
     ExpectAccurate(rig, calibration, 0.1, 0.005, 0.5, 2.0);
   }
@@ -195,10 +195,9 @@ TEST(Pipeline, CameraThatNeverLocalizesIsReportedOthersCalibrated) {
   // only, not by all cameras.
   CompareOptions compare;
   compare.alignment = RigAlignment::kReferenceCamera;
-  const CalibrationError error =
-      CompareCalibrations(rig.truth.cameras, rig.truth.cam_from_rig,
-                          calibration.cameras, calibration.cam_from_rig,
-                          compare);
+  const CalibrationError error = CompareCalibrations(
+      rig.truth.cameras, rig.truth.cam_from_rig, calibration.cameras,
+      calibration.cam_from_rig, compare);
   for (const int c : {1, 2, 4}) {
     EXPECT_TRUE(calibration.camera_calibrated[c]);
     EXPECT_LT(error.cameras[c].rotation_deg, 0.05);
@@ -226,8 +225,8 @@ TEST(Pipeline, InvalidDatasetIsRejected) {
   RigDataset dataset;
   RigCalibration calibration;
   PipelineReport report;
-  EXPECT_FALSE(CalibrateRig(QuietOptions(CalibrationMethod::kRadial1D),
-                            dataset, &calibration, &report));
+  EXPECT_FALSE(CalibrateRig(QuietOptions(CalibrationMethod::kRadial1D), dataset,
+                            &calibration, &report));
   EXPECT_NE(report.error.find("at least two cameras"), std::string::npos);
 }
 

@@ -164,8 +164,7 @@ Accuracy SolveRandomInstances(SceneKind kind, int num_instances,
       Scene mirrored = scene;
       mirrored.cam_from_world = MirrorThroughPlane(
           scene.cam_from_world, scene.plane_normal, scene.plane_offset);
-      EXPECT_GT(PoseError(mirrored.cam_from_world, scene.cam_from_world),
-                1e-3);
+      EXPECT_GT(PoseError(mirrored.cam_from_world, scene.cam_from_world), 1e-3);
       EXPECT_LT(BestSolutionError(mirrored, solutions), 1e-6);
     }
   }
@@ -217,8 +216,8 @@ TEST(RadialPoseSolver, DegenerateSamplesGiveNoInvalidPoses) {
   degenerate[3].points2D[4].y() = std::numeric_limits<double>::infinity();
   // Collinear 3D points.
   for (int i = 0; i < 5; ++i) {
-    degenerate[4].points3D[i] = scene.points3D[0] +
-                                i * (scene.points3D[1] - scene.points3D[0]);
+    degenerate[4].points3D[i] =
+        scene.points3D[0] + i * (scene.points3D[1] - scene.points3D[0]);
   }
   // Wrong sample size.
   degenerate[5].points2D.pop_back();
@@ -254,8 +253,8 @@ TEST(RadialReprojectionError, DistanceToTheHalfLine) {
   const Eigen::Vector3d X(2, 0, 5);
   EXPECT_NEAR(RadialReprojectionError(identity, Eigen::Vector2d(100, 3), X), 3,
               1e-12);
-  EXPECT_NEAR(RadialReprojectionError(identity, Eigen::Vector2d(100, -4), X),
-              4, 1e-12);
+  EXPECT_NEAR(RadialReprojectionError(identity, Eigen::Vector2d(100, -4), X), 4,
+              1e-12);
   EXPECT_EQ(RadialReprojectionError(identity, Eigen::Vector2d(250, 0), X), 0);
   // The focal length and the depth do not matter, only the direction.
   EXPECT_NEAR(RadialReprojectionError(identity, Eigen::Vector2d(100, 3),
@@ -269,11 +268,11 @@ TEST(RadialReprojectionError, DistanceToTheHalfLine) {
   EXPECT_EQ(RadialReprojectionError(identity, Eigen::Vector2d(100, 3),
                                     Eigen::Vector3d(0, 0, 5)),
             inf);
-  EXPECT_EQ(RadialReprojectionError(
-                identity,
-                Eigen::Vector2d(std::numeric_limits<double>::quiet_NaN(), 3),
-                X),
-            inf);
+  EXPECT_EQ(
+      RadialReprojectionError(
+          identity,
+          Eigen::Vector2d(std::numeric_limits<double>::quiet_NaN(), 3), X),
+      inf);
   // A pose with translation: t moves the point to (2 + 1, -3 + 3) = (3, 0).
   const Rigid3d shifted(Eigen::Quaterniond::Identity(),
                         Eigen::Vector3d(1, 3, 0));

@@ -44,7 +44,8 @@ TEST(Rigid3d, RotationDifferenceOfKnownAngle) {
 
 TEST(Rigid3d, NearestRotationOfNoisyRotation) {
   const Eigen::Matrix3d rotation = RandomTransform(5).RotationMatrix();
-  const Eigen::Matrix3d noisy = 2.0 * rotation;  // scaled: same nearest rotation
+  const Eigen::Matrix3d noisy =
+      2.0 * rotation;  // scaled: same nearest rotation
   EXPECT_LT((NearestRotation(noisy) - rotation).norm(), 1e-12);
   const Eigen::Matrix3d reflection = -rotation;  // det -1: still a rotation out
   EXPECT_NEAR(NearestRotation(reflection).determinant(), 1.0, 1e-12);

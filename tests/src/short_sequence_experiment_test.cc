@@ -32,7 +32,14 @@ TEST(ShortSequenceExperiment, SequencesAreTheSameForEveryMethod) {
   const std::vector<ShortSequenceResult> results =
       RunShortSequenceExperiment(options);
   ASSERT_EQ(results.size(), 2u);
-  EXPECT_EQ(results[0].max_rotation_deg, results[1].max_rotation_deg);
+  // Same sequences and seeds: the same result up to the rounding of Ceres's
+  // multi-threaded evaluation.
+  ASSERT_EQ(results[0].max_rotation_deg.size(), 2u);
+  ASSERT_EQ(results[1].max_rotation_deg.size(), 2u);
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_NEAR(results[0].max_rotation_deg[s], results[1].max_rotation_deg[s],
+                1e-6);
+  }
 }
 
 }  // namespace
