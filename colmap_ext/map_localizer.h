@@ -15,6 +15,13 @@
 //    else all map images for a small map, else the map images that see most
 //    of the image's direct matches.
 // Everything is read from the database; nothing is ever written to it.
+//
+// Why direct is the default (measured with the disabled benchmark in
+// tests/colmap_ext/map_localizer_test.cc, map of 300 images x 2000 features,
+// rig images of 2000 features): direct costs 0.26 CPU s per image (index of
+// 360k descriptors built in ~3 s), i.e. ~7.5 images/s on 2 cores; retrieval
+// with 10 map images costs 1.85 CPU s per image. `index.num_checks` 64
+// halves the direct cost (0.14 CPU s per image).
 #pragma once
 
 #include <colmap/base/reconstruction.h>

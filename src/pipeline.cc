@@ -219,12 +219,13 @@ bool FramesetPosed(const RigCalibration& calibration, const RigImage& image) {
          calibration.rig_from_world[image.frameset_index].has_value();
 }
 
-// Selects, for every image of a posed frameset, the correspondences within
-// `max_error_px` of the radial rig's prediction. This also brings in images
-// that could not be localized on their own but whose frameset was posed by
-// the other cameras.
-void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
-                         RigCalibration* calibration) {
+// Marks, for every image of a posed frameset, the correspondences that
+// `is_inlier(camera, cam_from_world, correspondence)` accepts; images of
+// other framesets get none. This also brings in images that could not be
+// localized on their own but whose frameset was posed by the other cameras.
+template <typename Predicate>
+void SelectInliers(const RigDataset& dataset, RigCalibration* calibration,
+                   const Predicate& is_inlier) {
   for (size_t i = 0; i < dataset.images.size(); ++i) {
     const RigImage& image = dataset.images[i];
     ImageResult& result = calibration->images[i];
@@ -234,13 +235,8 @@ void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
     const Rigid3d cam_from_world =
         calibration->CamFromWorld(image.camera_index, image.frameset_index);
     const colmap::Camera& camera = calibration->cameras[image.camera_index];
-    const Eigen::Vector2d principal_point(camera.PrincipalPointX(),
-                                          camera.PrincipalPointY());
     for (size_t k = 0; k < image.correspondences.size(); ++k) {
-      const double error = RadialReprojectionError(
-          cam_from_world, image.correspondences[k].point2D - principal_point,
-          image.correspondences[k].point3D);
-      if (error < max_error_px) {
+      if (is_inlier(camera, cam_from_world, image.correspondences[k])) {
         result.inlier_mask[k] = 1;
         ++result.num_inliers;
       }
@@ -248,32 +244,35 @@ void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
   }
 }
 
-// Selects, for every image of a posed frameset, the correspondences that the
-// current full calibration reprojects within `max_error_px`.
-void SelectInliers(const RigDataset& dataset, double max_error_px,
-                   RigCalibration* calibration) {
-  for (size_t i = 0; i < dataset.images.size(); ++i) {
-    const RigImage& image = dataset.images[i];
-    ImageResult& result = calibration->images[i];
-    result.inlier_mask.assign(image.correspondences.size(), 0);
-    result.num_inliers = 0;
-    if (!FramesetPosed(*calibration, image)) continue;
-    const Rigid3d cam_from_world =
-        calibration->CamFromWorld(image.camera_index, image.frameset_index);
-    const colmap::Camera& camera = calibration->cameras[image.camera_index];
-    for (size_t k = 0; k < image.correspondences.size(); ++k) {
-      const Eigen::Vector3d point_cam =
-          cam_from_world * image.correspondences[k].point3D;
-      if (point_cam.z() <= 1e-9) continue;
-      const Eigen::Vector2d projected =
-          camera.WorldToImage(point_cam.hnormalized());
-      if ((projected - image.correspondences[k].point2D).norm() <
-          max_error_px) {
-        result.inlier_mask[k] = 1;
-        ++result.num_inliers;
-      }
-    }
-  }
+// Inliers of the radial rig: radial reprojection error below max_error_px.
+void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
+                         RigCalibration* calibration) {
+  SelectInliers(dataset, calibration,
+                [&](const colmap::Camera& camera, const Rigid3d& cam_from_world,
+                    const Correspondence& correspondence) {
+                  const Eigen::Vector2d principal_point(
+                      camera.PrincipalPointX(), camera.PrincipalPointY());
+                  return RadialReprojectionError(
+                             cam_from_world,
+                             correspondence.point2D - principal_point,
+                             correspondence.point3D) < max_error_px;
+                });
+}
+
+// Inliers of the full calibration: in front of the camera and reprojected
+// within max_error_px.
+void SelectFullInliers(const RigDataset& dataset, double max_error_px,
+                       RigCalibration* calibration) {
+  SelectInliers(dataset, calibration,
+                [&](const colmap::Camera& camera, const Rigid3d& cam_from_world,
+                    const Correspondence& correspondence) {
+                  const Eigen::Vector3d point_cam =
+                      cam_from_world * correspondence.point3D;
+                  return point_cam.z() > 1e-9 &&
+                         (camera.WorldToImage(point_cam.hnormalized()) -
+                          correspondence.point2D)
+                                 .norm() < max_error_px;
+                });
 }
 
 // Paper §3.5: per camera, all its frames pooled, the forward translation tz
@@ -613,7 +612,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
 
   {
     Stage stage("Final bundle adjustment", options.print_progress, report);
-    SelectInliers(dataset, options.upgrade.max_error_px, calibration);
+    SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
     FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
     ba_options.num_threads = options.num_threads;
     if (method == CalibrationMethod::kKnown) {
