@@ -10,6 +10,11 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 
 bash "$repo/scripts/setup_deps.sh"
 
+# ccache (when installed) keeps compiled objects in the cache folder, keyed by
+# paths relative to the checkout, so a fresh clone elsewhere reuses them.
+export CCACHE_DIR="${CCACHE_DIR:-$cache/ccache}"
+export CCACHE_BASEDIR="$repo"
+
 echo "[build] configuring and building rig_calibrator in $build"
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$cache/colmap-3.8" > /dev/null \

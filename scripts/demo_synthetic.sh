@@ -12,6 +12,7 @@ out="${1:-$repo/demo_output/synthetic}"
 preset="${2:-ring5}"
 
 bash "$repo/scripts/build.sh"
+mkdir -p "$out"
 rig_calibrator="$build/rig_calibrator"
 
 echo "== Synthetic dataset ($preset) in $out/data"
