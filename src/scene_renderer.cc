@@ -88,11 +88,17 @@ CameraRays::CameraRays(const colmap::Camera& camera, int supersampling)
       } else {
         masked = true;
       }
+      // With an odd number of samples per axis the middle sample is the
+      // center, already computed.
+      const int middle = supersampling_ % 2 == 1 ? supersampling_ / 2 : -1;
       for (int sy = 0; sy < supersampling_; ++sy) {
         for (int sx = 0; sx < supersampling_; ++sx) {
           const Eigen::Vector2d sample(x + (sx + 0.5) / supersampling_,
                                        y + (sy + 0.5) / supersampling_);
-          if (UnitRay(camera, sample, &ray)) {
+          if (sx == middle && sy == middle) {
+            rays_[pixel * num_samples + sy * supersampling_ + sx] =
+                center_rays_[pixel];
+          } else if (UnitRay(camera, sample, &ray)) {
             rays_[pixel * num_samples + sy * supersampling_ + sx] =
                 ray.cast<float>();
           } else {

@@ -340,7 +340,7 @@ TexturedScene MakeStreet(unsigned int seed) {
     }
   }
   SceneWalk walk;
-  walk.radii = Eigen::Vector2d(18, 1.8);
+  walk.radii = Eigen::Vector2d(12, 1.8);
   walk.eye_height = 1.6;
   return TexturedScene(std::move(boxes), walk, seed);
 }

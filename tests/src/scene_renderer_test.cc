@@ -258,6 +258,8 @@ TEST(SceneRenderer, ScenePointsAppearWhereTheCameraModelProjectsThem) {
       }
     }
   }
+  std::cout << "patch match: NCC " << best_score << " at a shift of "
+            << best_shift.transpose() << " px" << std::endl;
   EXPECT_GT(best_score, 0.85);
   EXPECT_LE(best_shift.norm(), 0.25) << best_shift.transpose();
 }

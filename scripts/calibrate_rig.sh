@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Calibrates a rig against a COLMAP map: copies the map's database (the input
+# is never modified), extracts SIFT features of the rig images into the copy
+# (one COLMAP camera per camera folder), then runs rig_calibrator.
+#
+# Usage: scripts/calibrate_rig.sh MAP_DB MAP_MODEL RIG_IMAGES OUT [rig_calibrator options...]
+#   MAP_DB      the map's COLMAP 3.8 database (with its images' features)
+#   MAP_MODEL   the map: a COLMAP sparse model folder
+#   RIG_IMAGES  the rig images, one folder per camera (cam0/, cam1/, ...), the
+#               images of a frameset with the same file name
+#   OUT         created (must not exist or be empty); gets database.db (map +
+#               rig features) and calibration/ (rig_calibrator's output:
+#               model, rig_config.json, rigs/frames, camchain.yaml, summary)
+#   options     passed to rig_calibrator, e.g. --RigCalibrator.method 1dr
+#               --RigCalibrator.camera_model OPENCV
+# Environment:
+#   COLMAP            colmap 3.8 binary (default: the one built by
+#                     scripts/setup_deps.sh, else `colmap` on PATH)
+#   RIG_CALIBRATOR    rig_calibrator binary (default: build/rig_calibrator)
+#   RIG_MAX_FEATURES  SIFT features per rig image (default 4096)
+#   RIG_NUM_THREADS   feature extraction threads (default: all cores)
+set -euo pipefail
+
+usage() {
+  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'
+}
+
+if [[ $# -lt 4 || "$1" == "-h" || "$1" == "--help" ]]; then
+  usage >&2
+  exit 2
+fi
+map_db="$1"
+map_model="$2"
+rig_images="$3"
+out="$4"
+shift 4
+
+die() { echo "[calibrate_rig] ERROR: $*" >&2; exit 1; }
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
+if [[ -n "${COLMAP:-}" ]]; then
+  colmap="$COLMAP"
+elif [[ -x "$default_colmap" ]]; then
+  colmap="$default_colmap"
+elif command -v colmap > /dev/null; then
+  colmap="$(command -v colmap)"
+else
+  die "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
+fi
+[[ -x "$colmap" ]] || die "COLMAP=$colmap is not executable"
+rig_calibrator="${RIG_CALIBRATOR:-$repo/build/rig_calibrator}"
+[[ -x "$rig_calibrator" ]] || die "no rig_calibrator at $rig_calibrator: build it (scripts/build.sh) or set RIG_CALIBRATOR"
+max_features="${RIG_MAX_FEATURES:-4096}"
+threads="${RIG_NUM_THREADS:--1}"
+
+[[ -f "$map_db" ]] || die "no map database $map_db"
+[[ -f "$map_model/images.bin" || -f "$map_model/images.txt" ]] || die "no COLMAP model in $map_model"
+[[ -d "$rig_images" ]] || die "no rig image folder $rig_images"
+num_cameras=$(find "$rig_images" -mindepth 1 -maxdepth 1 -type d | wc -l)
+[[ "$num_cameras" -ge 1 ]] || die "$rig_images has no camera folders (cam0/, cam1/, ...)"
+if [[ -e "$out" && -n "$(ls -A "$out" 2>/dev/null)" ]]; then
+  die "$out exists and is not empty; choose another OUT"
+fi
+mkdir -p "$out"
+database="$out/database.db"
+log="$out/calibrate_rig.log"
+: > "$log"
+
+start=$SECONDS
+cp "$map_db" "$database"
+echo "[calibrate_rig] copied the map database to $database"
+echo "[calibrate_rig] feature extraction of the rig images ($num_cameras cameras) ..."
+if ! "$colmap" feature_extractor --database_path "$database" \
+    --image_path "$rig_images" --ImageReader.single_camera_per_folder 1 \
+    --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads "$threads" \
+    --SiftExtraction.max_num_features "$max_features" >> "$log" 2>&1; then
+  tail -n 20 "$log" >&2
+  die "colmap feature_extractor failed (full log: $log)"
+fi
+echo "[calibrate_rig] feature extraction: $((SECONDS - start)) s"
+
+start=$SECONDS
+echo "[calibrate_rig] rig_calibrator ..."
+status=0
+"$rig_calibrator" --database_path "$database" --image_path "$rig_images" \
+  --input_path "$map_model" --output_path "$out/calibration" "$@" 2>&1 |
+  tee -a "$log" || status=${PIPESTATUS[0]}
+[[ "$status" -eq 0 ]] || die "rig_calibrator failed with status $status (log: $log)"
+echo "[calibrate_rig] rig_calibrator: $((SECONDS - start)) s"
+echo "[calibrate_rig] done: calibration in $out/calibration"
