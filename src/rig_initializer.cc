@@ -16,7 +16,6 @@
 #include <sstream>
 #include <utility>
 #include <vector>
-#include <iostream>
 
 #include "src/radial_pose_solver.h"
 
@@ -37,11 +36,15 @@ constexpr double kMinAgreementRatio = 0.5;
 // Consensus rotations compare every candidate with every other: an evenly
 // spread subset bounds the quadratic cost.
 constexpr int kMaxRotationCandidates = 50;
+// Scoring a hypothesis runs on several threads from this many images per
+// thread on: below, starting threads costs more than it saves.
+constexpr size_t kMinImagesPerThread = 256;
 // Sweeps re-estimating every rotation after the greedy assignment.
 constexpr int kNumRotationSweeps = 2;
-// A camera takes part in an undetermined direction of the translations if
-// the direction's unit eigenvector has at least this norm on its unknowns.
-constexpr double kUndeterminedComponent = 0.1;
+// Iteratively reweighted least squares of the translations: iterations and
+// the Cauchy scale in robust standard deviations of the residuals.
+constexpr int kNumReweightings = 5;
+constexpr double kTranslationCauchyScale = 3.0;
 // A kept camera needs this many agreeing images: a wrong per-image pose
 // always agrees with the camera pose made from it.
 constexpr int kMinAgreeingImagesPerCamera = 2;
@@ -54,6 +57,10 @@ struct LocalizedImage {
   std::vector<Eigen::Vector2d> points2D;  // centered, scored inlier subset
   std::vector<Eigen::Vector3d> points3D;
   int num_own_inliers = 0;  // scored inliers within the truncation
+  // Centroid of the scored map points. Translations are compared there
+  // (eq. 3, eq. 4) rather than at the map's origin, whose distance would
+  // scale every rotation error into the translations.
+  Eigen::Vector3d scene_center = Eigen::Vector3d::Zero();
 };
 
 struct InitProblem {
@@ -125,7 +132,8 @@ double SmallestAxisEigenvalue(const std::vector<Eigen::Vector3d>& axes) {
 std::vector<std::optional<ImageFit>> FitHypothesis(
     const InitProblem& problem, const Hypothesis& hypothesis) {
   std::vector<std::optional<ImageFit>> fits(problem.images.size());
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+#pragma omp parallel for schedule(dynamic) num_threads( \
+    problem.num_threads) if (problem.images.size() >= kMinImagesPerThread * 2)
   for (size_t k = 0; k < problem.images.size(); ++k) {
     const LocalizedImage& image = problem.images[k];
     if (hypothesis.cam_from_rig[image.camera] &&
@@ -257,17 +265,12 @@ std::optional<RotationEstimate> CameraRotation(const InitProblem& problem,
   return ConsensusRotation(candidates, problem.max_rotation_deviation);
 }
 
-// Assigns the pending estimates supported by two candidates if there are
-// any, else those supported by one: a wrong per-image pose always supports
-// the estimate made from it alone. Returns whether anything was assigned.
-bool AssignBySupport(
+// Assigns the pending estimates with at least min_support. Returns whether
+// anything was assigned.
+bool AssignSupported(
     const std::vector<std::optional<RotationEstimate>>& pending,
+    int min_support,
     std::vector<std::optional<Eigen::Quaterniond>>* rotations) {
-  int max_support = 0;
-  for (const std::optional<RotationEstimate>& estimate : pending) {
-    if (estimate) max_support = std::max(max_support, estimate->support);
-  }
-  const int min_support = std::clamp(max_support, 1, 2);
   bool assigned = false;
   for (size_t k = 0; k < pending.size(); ++k) {
     if (pending[k] && pending[k]->support >= min_support) {
@@ -281,11 +284,11 @@ bool AssignBySupport(
 // The greedy back-and-forth assignment of one RANSAC trial, on rotations.
 // With radial poses every image's rotation is complete (its third row is the
 // cross product of the first two), so one camera with a rotation places a
-// frameset's rotation and one frameset places a camera's: frameset sets of
-// 2-3 cameras still connect the whole rig. The seed frameset places its
-// cameras relative to a base camera (the reference camera if there), whose
-// frame is the hypothesis' rig frame. After the greedy pass, two sweeps
-// re-estimate every rotation from all the others, which repairs early
+// frameset's rotation and one frameset places a camera's: framesets of 2-3
+// cameras still connect the whole rig. The seed frameset places its cameras
+// relative to a base camera (the reference camera if there), whose frame is
+// the hypothesis' rig frame. After the greedy pass, sweeps re-estimate every
+// rotation but the base camera's from all the others, which repairs early
 // choices made on little support.
 Rotations AssignRotationsGreedily(const InitProblem& problem, int seed_frameset,
                                   int* base_camera) {
@@ -312,45 +315,51 @@ Rotations AssignRotationsGreedily(const InitProblem& problem, int seed_frameset,
       problem.num_framesets);
   std::vector<std::optional<RotationEstimate>> pending_cameras(
       problem.num_cameras);
-  bool changed = true;
-  while (changed) {
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
+  while (true) {
     for (int j = 0; j < problem.num_framesets; ++j) {
       pending_framesets[j] = rotations.rig_from_world[j]
                                  ? std::nullopt
                                  : FramesetRotation(problem, rotations, j);
     }
-    changed = AssignBySupport(pending_framesets, &rotations.rig_from_world);
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
     for (int i = 0; i < problem.num_cameras; ++i) {
       pending_cameras[i] = rotations.cam_from_rig[i]
                                ? std::nullopt
                                : CameraRotation(problem, rotations, i);
     }
-    changed =
-        AssignBySupport(pending_cameras, &rotations.cam_from_rig) || changed;
+    // Estimates confirmed by two images first (framesets and cameras: `|`
+    // does not short-circuit). Then framesets resting on one image (a wrong
+    // one spoils that frameset only), and cameras resting on one image last
+    // (a wrong one spoils all that is placed through it).
+    const bool assigned_confirmed =
+        AssignSupported(pending_framesets, 2, &rotations.rig_from_world) |
+        AssignSupported(pending_cameras, 2, &rotations.cam_from_rig);
+    if (assigned_confirmed ||
+        AssignSupported(pending_framesets, 1, &rotations.rig_from_world) ||
+        AssignSupported(pending_cameras, 1, &rotations.cam_from_rig)) {
+      continue;
+    }
+    break;
   }
 
   for (int sweep = 0; sweep < kNumRotationSweeps; ++sweep) {
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
     for (int j = 0; j < problem.num_framesets; ++j) {
       if (rotations.rig_from_world[j]) {
         pending_framesets[j] = FramesetRotation(problem, rotations, j);
       }
     }
     for (int j = 0; j < problem.num_framesets; ++j) {
-      if (rotations.rig_from_world[j]) {
+      if (rotations.rig_from_world[j] && pending_framesets[j]) {
         rotations.rig_from_world[j] = pending_framesets[j]->rotation;
       }
     }
-#pragma omp parallel for schedule(dynamic) num_threads(problem.num_threads)
     for (int i = 0; i < problem.num_cameras; ++i) {
       if (rotations.cam_from_rig[i] && i != *base_camera) {
         pending_cameras[i] = CameraRotation(problem, rotations, i);
       }
     }
     for (int i = 0; i < problem.num_cameras; ++i) {
-      if (rotations.cam_from_rig[i] && i != *base_camera) {
+      if (rotations.cam_from_rig[i] && i != *base_camera &&
+          pending_cameras[i]) {
         rotations.cam_from_rig[i] = pending_cameras[i]->rotation;
       }
     }
@@ -420,31 +429,46 @@ DeterminedParts FindDeterminedParts(
   return parts;
 }
 
-// The translations' least-squares problem after eliminating the framesets'
-// t_Q: reduced * t_P = reduced_rhs over the t_P of the non-anchor cameras.
+// The translations' weighted least-squares problem after eliminating the
+// framesets' t_Q: reduced * t_P = reduced_rhs over the t_P of the
+// non-anchor cameras.
 struct ReducedTranslationSystem {
   std::vector<int> unknown_of_camera;  // offset into t_P, -1: anchor/unused
   std::vector<Eigen::MatrixXd> known_rows;  // per camera, rows of R_P
   Eigen::MatrixXd reduced;
   Eigen::VectorXd reduced_rhs;
-  // Per frameset: H_j = sum_i A_i^T A_i and sum_i A_i^T b_ij.
+  // Per frameset: H_j = sum_i w_i A_i^T A_i and sum_i w_i A_i^T b_ij.
   std::vector<Eigen::Matrix3d> frameset_normal;
   std::vector<Eigen::Vector3d> frameset_rhs;
 };
 
+// The known rows of T X - A R_Q X at the image's scene center X: the
+// right-hand side b_ij of eq. 3's translation rows once R_Q is known.
+Eigen::VectorXd ObservedRows(const LocalizedImage& image,
+                             const Eigen::MatrixXd& known_rows,
+                             const Eigen::Quaterniond& rig_rotation) {
+  return (image.cam_from_world * image.scene_center).head(known_rows.rows()) -
+         known_rows * (rig_rotation * image.scene_center);
+}
+
 // Given the rotations, the known translation rows are linear in the
 // unknowns: per used image (camera i, frameset j), with A_i the known rows of
-// R_P and b_ij those of t_T,
-//   A_i t_Q,j + t_P,i = b_ij   (t_P,i: the known rows of camera i's t).
-// Eliminating t_Q,j = H_j^-1 (sum_i A_i^T (b_ij - t_P,i)) leaves, per pair of
-// images (i, k) of a frameset, delta_ik I - A_i H_j^-1 A_k^T, and right-hand
-// side b_ij - A_i H_j^-1 sum_k A_k^T b_kj. Gauge: the anchor camera's
+// R_P, comparing the camera-frame positions of the image's scene center X,
+//   A_i (R_Q,j X + t_Q,j) + t_P,i = rows of T_ij X, i.e.
+//   A_i t_Q,j + t_P,i = b_ij   (t_P,i: the known rows of camera i's t),
+// weighted by w_ij. Eliminating t_Q,j = H_j^-1 (sum_i w_i A_i^T (b_ij -
+// t_P,i)) leaves, per pair of images (i, k) of a frameset,
+// w_i delta_ik I - w_i w_k A_i H_j^-1 A_k^T, and right-hand side
+// w_i (b_ij - A_i H_j^-1 sum_k w_k A_k^T b_kj). Gauge: the anchor camera's
 // t_P = 0 and, when radial, the slide of the rig origin along the anchor's
 // axis z (t_P,i += d (R_P,i z)_xy for all i) is fixed by
 // sum_i v_i^T t_P,i = 0 with v_i = (R_P,i z)_xy.
 ReducedTranslationSystem BuildReducedTranslationSystem(
-    const InitProblem& problem, const Rotations& rotations,
-    const DeterminedParts& parts, int anchor_camera) {
+    const InitProblem& problem,
+    const std::vector<std::optional<Eigen::Quaterniond>>& cam_rotations,
+    const std::vector<std::optional<Eigen::Quaterniond>>& rig_rotations,
+    const DeterminedParts& parts, const std::vector<double>& weights,
+    int anchor_camera) {
   const int rows = problem.num_rows;
   ReducedTranslationSystem system;
   system.unknown_of_camera.assign(problem.num_cameras, -1);
@@ -452,8 +476,7 @@ ReducedTranslationSystem BuildReducedTranslationSystem(
   int num_unknowns = 0;
   for (int i = 0; i < problem.num_cameras; ++i) {
     if (!parts.cameras[i]) continue;
-    system.known_rows[i] =
-        rotations.cam_from_rig[i]->toRotationMatrix().topRows(rows);
+    system.known_rows[i] = cam_rotations[i]->toRotationMatrix().topRows(rows);
     if (i != anchor_camera) {
       system.unknown_of_camera[i] = num_unknowns;
       num_unknowns += rows;
@@ -466,40 +489,43 @@ ReducedTranslationSystem BuildReducedTranslationSystem(
   for (int j = 0; j < problem.num_framesets; ++j) {
     if (!parts.framesets[j]) continue;
     std::vector<int> used;
+    std::vector<Eigen::VectorXd> observed;
     for (const int index : problem.images_of_frameset[j]) {
       if (!parts.images[index]) continue;
       const LocalizedImage& image = problem.images[index];
       const Eigen::MatrixXd& a = system.known_rows[image.camera];
-      system.frameset_normal[j] += a.transpose() * a;
+      observed.push_back(ObservedRows(image, a, *rig_rotations[j]));
+      system.frameset_normal[j] += weights[index] * a.transpose() * a;
       system.frameset_rhs[j] +=
-          a.transpose() * image.cam_from_world.translation.head(rows);
+          weights[index] * a.transpose() * observed.back();
       used.push_back(index);
     }
     const Eigen::Matrix3d inverse = system.frameset_normal[j].inverse();
-    for (const int index : used) {
+    for (size_t n = 0; n < used.size(); ++n) {
+      const int index = used[n];
       const LocalizedImage& image = problem.images[index];
       const int u = system.unknown_of_camera[image.camera];
       if (u < 0) continue;
       const Eigen::MatrixXd a_inverse =
-          system.known_rows[image.camera] * inverse;
+          weights[index] * system.known_rows[image.camera] * inverse;
       system.reduced_rhs.segment(u, rows) +=
-          image.cam_from_world.translation.head(rows) -
-          a_inverse * system.frameset_rhs[j];
+          weights[index] * observed[n] - a_inverse * system.frameset_rhs[j];
       system.reduced.block(u, u, rows, rows) +=
-          Eigen::MatrixXd::Identity(rows, rows);
+          weights[index] * Eigen::MatrixXd::Identity(rows, rows);
       for (const int other : used) {
         const int camera = problem.images[other].camera;
         const int v = system.unknown_of_camera[camera];
         if (v >= 0) {
           system.reduced.block(u, v, rows, rows) -=
-              a_inverse * system.known_rows[camera].transpose();
+              weights[other] * a_inverse *
+              system.known_rows[camera].transpose();
         }
       }
     }
   }
   if (rows == 2 && num_unknowns > 0) {
     const Eigen::Vector3d anchor_axis =
-        rotations.cam_from_rig[anchor_camera]->toRotationMatrix().row(2);
+        cam_rotations[anchor_camera]->toRotationMatrix().row(2);
     Eigen::VectorXd slide = Eigen::VectorXd::Zero(num_unknowns);
     for (int i = 0; i < problem.num_cameras; ++i) {
       const int u = system.unknown_of_camera[i];
@@ -510,93 +536,181 @@ ReducedTranslationSystem BuildReducedTranslationSystem(
   return system;
 }
 
+// Whether the images of `parts` determine all camera translations relative
+// to the anchor: no eigenvalue of the unweighted reduced matrix (gauge
+// fixed) below min_axis_eigenvalue / 2. The matrix is dimensionless; one
+// frameset with two cameras at the minimum angle contributes about
+// min_axis_eigenvalue.
+bool TranslationsDetermined(
+    const InitProblem& problem,
+    const std::vector<std::optional<Eigen::Quaterniond>>& cam_rotations,
+    const std::vector<std::optional<Eigen::Quaterniond>>& rig_rotations,
+    const DeterminedParts& parts, int anchor) {
+  const ReducedTranslationSystem system = BuildReducedTranslationSystem(
+      problem, cam_rotations, rig_rotations, parts,
+      std::vector<double>(problem.images.size(), 1.0), anchor);
+  return system.reduced.rows() == 0 ||
+         Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(system.reduced,
+                                                        Eigen::EigenvaluesOnly)
+                 .eigenvalues()(0) >= 0.5 * problem.min_axis_eigenvalue;
+}
+
+// FindDeterminedParts, restricted further to the cameras whose translations
+// the images determine. Every frameset being determined is not enough: e.g.
+// a radial camera only ever seen with one other camera can slide along that
+// camera's axis. An undetermined direction of the whole system mixes with
+// the gauge and cannot say which cameras it moves, so the determined set is
+// grown from the anchor instead: a camera joins if the images of the joined
+// cameras and its own determine all their translations. The anchor camera,
+// whose t_P is held, is preferred_anchor if kept, else the first kept
+// camera; *anchor = num_cameras if none is kept.
+DeterminedParts FindTranslationDeterminedParts(
+    const InitProblem& problem,
+    const std::vector<std::optional<Eigen::Quaterniond>>& cam_rotations,
+    const std::vector<std::optional<Eigen::Quaterniond>>& rig_rotations,
+    std::vector<char> usable_images, int min_images_per_camera,
+    int preferred_anchor, int* anchor) {
+  while (true) {
+    const DeterminedParts parts = FindDeterminedParts(
+        problem, cam_rotations, usable_images, min_images_per_camera);
+    *anchor = parts.cameras[preferred_anchor]
+                  ? preferred_anchor
+                  : std::find(parts.cameras.begin(), parts.cameras.end(), 1) -
+                        parts.cameras.begin();
+    if (*anchor == problem.num_cameras) return parts;
+
+    std::vector<char> joined(problem.num_cameras, 0);
+    joined[*anchor] = 1;
+    bool grown = true;
+    while (grown) {
+      grown = false;
+      for (int i = 0; i < problem.num_cameras; ++i) {
+        if (joined[i] || !parts.cameras[i]) continue;
+        std::vector<char> subset_images = parts.images;
+        for (size_t k = 0; k < problem.images.size(); ++k) {
+          const int camera = problem.images[k].camera;
+          subset_images[k] =
+              subset_images[k] && (joined[camera] || camera == i);
+        }
+        const DeterminedParts subset =
+            FindDeterminedParts(problem, cam_rotations, subset_images, 1);
+        if (subset.cameras[i] && subset.cameras[*anchor] &&
+            TranslationsDetermined(problem, cam_rotations, rig_rotations,
+                                   subset, *anchor)) {
+          joined[i] = 1;
+          grown = true;
+        }
+      }
+    }
+    if (joined == parts.cameras) return parts;
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      if (!joined[problem.images[k].camera]) usable_images[k] = 0;
+    }
+  }
+}
+
+// Solves a reduced system: camera translations, then the framesets' t_Q.
+Hypothesis SolveReducedSystem(const InitProblem& problem,
+                              const Rotations& rotations,
+                              const DeterminedParts& parts,
+                              const std::vector<double>& weights,
+                              const ReducedTranslationSystem& system) {
+  Hypothesis hypothesis;
+  hypothesis.cam_from_rig.resize(problem.num_cameras);
+  hypothesis.rig_from_world.resize(problem.num_framesets);
+  const int rows = problem.num_rows;
+  const Eigen::VectorXd translations =
+      system.reduced.ldlt().solve(system.reduced_rhs);
+  for (int i = 0; i < problem.num_cameras; ++i) {
+    if (!parts.cameras[i]) continue;
+    Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+    const int u = system.unknown_of_camera[i];
+    if (u >= 0) translation.head(rows) = translations.segment(u, rows);
+    hypothesis.cam_from_rig[i] =
+        Rigid3d(*rotations.cam_from_rig[i], translation);
+  }
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (!parts.framesets[j]) continue;
+    Eigen::Vector3d rhs = system.frameset_rhs[j];
+    for (const int index : problem.images_of_frameset[j]) {
+      const int camera = problem.images[index].camera;
+      if (parts.images[index]) {
+        rhs -= weights[index] * system.known_rows[camera].transpose() *
+               hypothesis.cam_from_rig[camera]->translation.head(rows);
+      }
+    }
+    hypothesis.rig_from_world[j] =
+        Rigid3d(*rotations.rig_from_world[j],
+                system.frameset_normal[j].ldlt().solve(rhs));
+  }
+  return hypothesis;
+}
+
 // Translations by least squares over the usable images jointly (see
 // BuildReducedTranslationSystem), so that each camera draws on every
-// frameset it shares with any other camera. Some directions may still be
-// undetermined although every frameset is: e.g. a radial camera only ever
-// seen with one other camera can slide along that camera's axis. Those are
-// the eigenvectors of the reduced matrix with eigenvalues below
-// min_axis_eigenvalue / 2 (the matrix is dimensionless; one frameset with two
-// cameras at the minimum angle contributes about min_axis_eigenvalue); their
-// cameras are dropped and the rest solved again.
+// frameset it shares with any other camera. Cameras in undetermined
+// directions are dropped first. A per-image pose with a right rotation and
+// a wrong translation (a wrong place that looks alike) would pull the
+// solution, so it is iteratively reweighted: Cauchy weights
+// 1 / (1 + (r / (c sigma))^2) on the norm r of each image's residual
+// A_i t_Q + t_P,i - b_ij, with sigma = 1.4826 median(r) (no absolute scale:
+// the map's units are unknown).
 Hypothesis SolveTranslations(const InitProblem& problem,
                              const Rotations& rotations,
                              const std::vector<char>& usable_images,
                              int preferred_anchor) {
-  Hypothesis hypothesis;
-  hypothesis.cam_from_rig.resize(problem.num_cameras);
-  hypothesis.rig_from_world.resize(problem.num_framesets);
   std::vector<char> usable = usable_images;
   for (size_t k = 0; k < problem.images.size(); ++k) {
     usable[k] =
         usable[k] &&
         rotations.rig_from_world[problem.images[k].frameset].has_value();
   }
-  while (true) {
-    const DeterminedParts parts =
-        FindDeterminedParts(problem, rotations.cam_from_rig, usable, 1);
-    int anchor = preferred_anchor;
-    if (!parts.cameras[anchor]) {
-      anchor = std::find(parts.cameras.begin(), parts.cameras.end(), 1) -
-               parts.cameras.begin();
-      if (anchor == problem.num_cameras) return hypothesis;
-    }
-    const ReducedTranslationSystem system =
-        BuildReducedTranslationSystem(problem, rotations, parts, anchor);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(system.reduced);
-    std::vector<char> undetermined(problem.num_cameras, 0);
-    bool any_undetermined = false;
-    for (int e = 0; e < system.reduced.rows(); ++e) {
-      if (eigen.eigenvalues()(e) >= 0.5 * problem.min_axis_eigenvalue) break;
-      for (int i = 0; i < problem.num_cameras; ++i) {
-        const int u = system.unknown_of_camera[i];
-        if (u >= 0 &&
-            eigen.eigenvectors().col(e).segment(u, problem.num_rows).norm() >
-                kUndeterminedComponent) {
-          undetermined[i] = 1;
-          any_undetermined = true;
-        }
-      }
-    }
-    if (any_undetermined) {
-      for (size_t k = 0; k < problem.images.size(); ++k) {
-        if (undetermined[problem.images[k].camera]) usable[k] = 0;
-      }
-      continue;
-    }
-
-    const Eigen::VectorXd translations =
-        eigen.eigenvectors() *
-        (eigen.eigenvectors().transpose() * system.reduced_rhs)
-            .cwiseQuotient(eigen.eigenvalues());
-    for (int i = 0; i < problem.num_cameras; ++i) {
-      if (!parts.cameras[i]) continue;
-      Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-      const int u = system.unknown_of_camera[i];
-      if (u >= 0) {
-        translation.head(problem.num_rows) =
-            translations.segment(u, problem.num_rows);
-      }
-      hypothesis.cam_from_rig[i] =
-          Rigid3d(*rotations.cam_from_rig[i], translation);
-    }
-    for (int j = 0; j < problem.num_framesets; ++j) {
-      if (!parts.framesets[j]) continue;
-      Eigen::Vector3d rhs = system.frameset_rhs[j];
-      for (const int index : problem.images_of_frameset[j]) {
-        const int camera = problem.images[index].camera;
-        if (parts.images[index]) {
-          rhs -= system.known_rows[camera].transpose() *
-                 hypothesis.cam_from_rig[camera]->translation.head(
-                     problem.num_rows);
-        }
-      }
-      hypothesis.rig_from_world[j] =
-          Rigid3d(*rotations.rig_from_world[j],
-                  system.frameset_normal[j].ldlt().solve(rhs));
-    }
-    return hypothesis;
+  int anchor = 0;
+  const DeterminedParts parts = FindTranslationDeterminedParts(
+      problem, rotations.cam_from_rig, rotations.rig_from_world, usable, 1,
+      preferred_anchor, &anchor);
+  if (anchor == problem.num_cameras) {
+    Hypothesis empty;
+    empty.cam_from_rig.resize(problem.num_cameras);
+    empty.rig_from_world.resize(problem.num_framesets);
+    return empty;
   }
+  std::vector<double> weights(problem.images.size(), 1.0);
+  ReducedTranslationSystem system = BuildReducedTranslationSystem(
+      problem, rotations.cam_from_rig, rotations.rig_from_world, parts, weights,
+      anchor);
+  Hypothesis hypothesis =
+      SolveReducedSystem(problem, rotations, parts, weights, system);
+  for (int iteration = 0; iteration < kNumReweightings; ++iteration) {
+    std::vector<double> residuals(problem.images.size(), 0);
+    std::vector<double> used_residuals;
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      if (!parts.images[k]) continue;
+      const LocalizedImage& image = problem.images[k];
+      const Rigid3d composed = *hypothesis.cam_from_rig[image.camera] *
+                               *hypothesis.rig_from_world[image.frameset];
+      Eigen::Vector3d difference = composed * image.scene_center -
+                                   image.cam_from_world * image.scene_center;
+      if (problem.num_rows == 2) difference.z() = 0;
+      residuals[k] = difference.norm();
+      used_residuals.push_back(residuals[k]);
+    }
+    std::nth_element(used_residuals.begin(),
+                     used_residuals.begin() + used_residuals.size() / 2,
+                     used_residuals.end());
+    const double scale = kTranslationCauchyScale * 1.4826 *
+                         used_residuals[used_residuals.size() / 2];
+    if (!(scale > 0)) break;
+    for (size_t k = 0; k < problem.images.size(); ++k) {
+      const double ratio = residuals[k] / scale;
+      weights[k] = 1.0 / (1.0 + ratio * ratio);
+    }
+    system = BuildReducedTranslationSystem(problem, rotations.cam_from_rig,
+                                           rotations.rig_from_world, parts,
+                                           weights, anchor);
+    hypothesis = SolveReducedSystem(problem, rotations, parts, weights, system);
+  }
+  return hypothesis;
 }
 
 // One RANSAC hypothesis: rotations by greedy assignment, then translations
@@ -651,23 +765,26 @@ Rigid3d FromParameters(const std::array<double, 6>& parameters) {
 }
 
 // d(T, P Q) of eq. 4 as a residual vector: the angle-axis vector of
-// R_T^T R_P R_Q (3, radians), then translation_weight * (R_P t_Q + t_P - t_T)
-// over the kRows known rows. Parameters: P and Q as (angle-axis, t).
+// R_T^T R_P R_Q (3, radians), then translation_weight times the difference
+// of the camera-frame positions of the image's scene center X,
+// P Q X - T X, over the kRows known rows (map units; at X rather than at the
+// map's origin, see LocalizedImage). Parameters: P and Q as (angle-axis, t).
 template <int kRows>
 class PoseDeviationCost {
  public:
-  PoseDeviationCost(const Rigid3d& cam_from_world, double translation_weight)
-      : inverse_rotation_{cam_from_world.rotation.w(),
-                          -cam_from_world.rotation.x(),
-                          -cam_from_world.rotation.y(),
-                          -cam_from_world.rotation.z()},
-        translation_(cam_from_world.translation),
+  PoseDeviationCost(const LocalizedImage& image, double translation_weight)
+      : inverse_rotation_{image.cam_from_world.rotation.w(),
+                          -image.cam_from_world.rotation.x(),
+                          -image.cam_from_world.rotation.y(),
+                          -image.cam_from_world.rotation.z()},
+        scene_center_(image.scene_center),
+        observed_center_(image.cam_from_world * image.scene_center),
         translation_weight_(translation_weight) {}
 
-  static ceres::CostFunction* Create(const Rigid3d& cam_from_world,
+  static ceres::CostFunction* Create(const LocalizedImage& image,
                                      double translation_weight) {
     return new ceres::AutoDiffCostFunction<PoseDeviationCost, 3 + kRows, 6, 6>(
-        new PoseDeviationCost(cam_from_world, translation_weight));
+        new PoseDeviationCost(image, translation_weight));
   }
 
   template <typename T>
@@ -682,19 +799,24 @@ class PoseDeviationCost {
         T(inverse_rotation_[2]), T(inverse_rotation_[3])};
     ceres::QuaternionProduct(inverse_rotation, composed, difference);
     ceres::QuaternionToAngleAxis(difference, residuals);
-    T translation[3];
-    ceres::AngleAxisRotatePoint(cam_from_rig, rig_from_world + 3, translation);
+    const T scene_center[3] = {T(scene_center_(0)), T(scene_center_(1)),
+                               T(scene_center_(2))};
+    T in_rig[3], in_cam[3];
+    ceres::AngleAxisRotatePoint(rig_from_world, scene_center, in_rig);
+    for (int r = 0; r < 3; ++r) in_rig[r] += rig_from_world[3 + r];
+    ceres::AngleAxisRotatePoint(cam_from_rig, in_rig, in_cam);
     for (int r = 0; r < kRows; ++r) {
       residuals[3 + r] =
           T(translation_weight_) *
-          (translation[r] + cam_from_rig[3 + r] - T(translation_(r)));
+          (in_cam[r] + cam_from_rig[3 + r] - T(observed_center_(r)));
     }
     return true;
   }
 
  private:
   const std::array<double, 4> inverse_rotation_;
-  const Eigen::Vector3d translation_;
+  const Eigen::Vector3d scene_center_;
+  const Eigen::Vector3d observed_center_;
   const double translation_weight_;
 };
 
@@ -729,9 +851,9 @@ void MinimizePoseDeviation(const InitProblem& problem,
     const LocalizedImage& image = problem.images[k];
     ceres::CostFunction* cost =
         radial ? PoseDeviationCost<2>::Create(
-                     image.cam_from_world, problem.options.translation_weight)
+                     image, problem.options.translation_weight)
                : PoseDeviationCost<3>::Create(
-                     image.cam_from_world, problem.options.translation_weight);
+                     image, problem.options.translation_weight);
     ceres_problem.AddResidualBlock(cost, loss,
                                    cam_parameters[image.camera].data(),
                                    rig_parameters[image.frameset].data());
@@ -809,8 +931,9 @@ void ExpressInReferenceFrame(const InitProblem& problem,
 
 // Which images, cameras and rig poses the final rig keeps: the images that
 // agree with the hypothesis, the framesets they determine, the cameras with
-// two of them in such framesets (FindDeterminedParts). The others are
-// unassigned in the hypothesis.
+// two of them in such framesets and no undetermined translation direction
+// (FindTranslationDeterminedParts). The others are unassigned in the
+// hypothesis.
 std::vector<char> KeepDeterminedParts(const InitProblem& problem,
                                       const std::vector<char>& agree,
                                       Hypothesis* hypothesis) {
@@ -821,8 +944,17 @@ std::vector<char> KeepDeterminedParts(const InitProblem& problem,
       cam_rotations[i] = hypothesis->cam_from_rig[i]->rotation;
     }
   }
-  const DeterminedParts parts = FindDeterminedParts(
-      problem, cam_rotations, agree, kMinAgreeingImagesPerCamera);
+  std::vector<std::optional<Eigen::Quaterniond>> rig_rotations(
+      problem.num_framesets);
+  for (int j = 0; j < problem.num_framesets; ++j) {
+    if (hypothesis->rig_from_world[j]) {
+      rig_rotations[j] = hypothesis->rig_from_world[j]->rotation;
+    }
+  }
+  int anchor = 0;
+  const DeterminedParts parts = FindTranslationDeterminedParts(
+      problem, cam_rotations, rig_rotations, agree, kMinAgreeingImagesPerCamera,
+      problem.reference_camera, &anchor);
   for (int j = 0; j < problem.num_framesets; ++j) {
     if (!parts.framesets[j]) hypothesis->rig_from_world[j].reset();
   }
@@ -945,6 +1077,11 @@ std::string BuildProblem(const RigInitializerOptions& options,
     image.num_own_inliers =
         FitImage(image.cam_from_world, image, options.max_radial_error_px)
             .num_within;
+    // A pose that does not explain its own inliers can agree with nothing.
+    if (image.num_own_inliers < kMinAgreeingInliers) continue;
+    for (const Eigen::Vector3d& point : image.points3D) {
+      image.scene_center += point / image.points3D.size();
+    }
     problem->images_of_frameset[image.frameset].push_back(
         problem->images.size());
     problem->images_of_camera[image.camera].push_back(problem->images.size());
@@ -1004,12 +1141,6 @@ bool InitializeRig(const RigInitializerOptions& options,
     const std::vector<std::optional<ImageFit>> fits =
         FitHypothesis(problem, hypothesis);
     const double score = TruncatedScore(problem, fits);
-    if (getenv("RIGDEBUG")) {
-      int nc = 0, nf = 0;
-      for (auto& c : hypothesis.cam_from_rig) nc += c.has_value();
-      for (auto& c : hypothesis.rig_from_world) nf += c.has_value();
-      std::cerr << "TRIAL seed " << seeds[num_trials - 1] << " cams " << nc << " framesets " << nf << " score " << score << std::endl;
-    }
     if (score >= best_score) continue;
     best = std::move(hypothesis);
     best_score = score;
@@ -1058,9 +1189,11 @@ bool InitializeRig(const RigInitializerOptions& options,
       problem, AgreeingImages(problem, FitHypothesis(problem, best)), &best);
   if (!best.cam_from_rig[problem.reference_camera]) {
     std::ostringstream message;
-    message << "none of the " << num_reference_images
-            << " localized images of the reference camera " << reference_name
-            << " agrees with the best rig hypothesis; choose another "
+    message << "the reference camera " << reference_name
+            << " cannot be placed in the rig: fewer than two of its "
+            << num_reference_images
+            << " localized images agree with the best rig hypothesis, or "
+               "they do not determine its position; choose another "
                "reference camera";
     return Fail(message.str(), summary);
   }
@@ -1073,6 +1206,18 @@ bool InitializeRig(const RigInitializerOptions& options,
     if (best.cam_from_rig[i]) {
       calibration->cam_from_rig[i] = *best.cam_from_rig[i];
       calibration->camera_calibrated[i] = true;
+    } else if (!problem.images_of_camera[i].empty()) {
+      LOG(WARNING) << "InitializeRig: camera " << dataset.cameras[i].name
+                   << " is left out of the rig although "
+                   << problem.images_of_camera[i].size()
+                   << " of its images are localized: fewer than two agree "
+                      "with the rig, or they do not determine its position"
+                   << (options.radial
+                           ? " (a radial camera seen only in framesets of two "
+                             "cameras whose axes are (nearly) coplanar with "
+                             "its own cannot be placed within that plane; it "
+                             "needs framesets with two other cameras)"
+                           : "");
     }
   }
   calibration->cam_from_rig[problem.reference_camera] = Rigid3d();

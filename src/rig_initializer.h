@@ -47,8 +47,12 @@ struct RigInitializerOptions {
   // radial score judges what remains).
   double max_rotation_deviation_deg = 5.0;
   // Cauchy scale of the local optimization of eq. 4, in the units of
-  // d(T, P Q): rotation difference in radians, plus translation_weight times
-  // the translation difference in map units (first two rows when radial).
+  // d(T, P Q): |(rotation difference in radians, translation_weight times
+  // translation difference in map units)|. The translation difference is
+  // that of the camera-frame positions of the image's scene center
+  // (centroid of its scored map points) under T and P Q (first two rows
+  // when radial): unlike t_T - t_PQ it does not grow with the distance from
+  // the map's origin.
   double loss_scale = 1.0;
   // Radians per map unit: weight of the translation difference against the
   // rotation difference in d(T, P Q).
@@ -72,6 +76,8 @@ struct RigInitializerSummary {
   // Localized images whose pose and correspondences agree with the rig; the
   // observations of eq. 4.
   int num_images_consistent = 0;
+  // Localized images whose own pose puts at least 5 of their scored inliers
+  // within max_radial_error_px; the others are ignored.
   int num_images_localized = 0;
   // Why InitializeRig failed; empty on success.
   std::string message;
@@ -99,17 +105,23 @@ struct RigInitializerSummary {
 //     two sweeps re-estimate everything at the end. A radial pose's rotation
 //     is complete, so one shared camera links a frameset: partial framesets
 //     of 2-3 cameras still connect the rig.
-//  2. Translations. Eq. 3's observable rows, A_i t_Q + t_P,i = b_ij, are
-//     linear once the rotations are known; they are solved jointly by least
-//     squares over all images whose rotation agrees with the rig (each
-//     frameset's t_Q eliminated by Schur complement; radial rigs need two
-//     cameras with non-parallel axes per frameset), and once more over those
-//     whose correspondences agree with the result.
+//  2. Translations. Eq. 3's observable rows are linear once the rotations
+//     are known, A_i (R_Q X + t_Q) + t_P,i = rows of T_ij X, compared at
+//     the image's scene center X. They are solved jointly by least squares
+//     over all images whose rotation agrees with the rig (each frameset's
+//     t_Q eliminated by Schur complement; radial rigs need two cameras with
+//     non-parallel axes per frameset), iteratively reweighted (Cauchy), and
+//     once more over those whose correspondences agree with the result.
+//     Cameras whose translation the images leave (nearly) undetermined are
+//     dropped: e.g. a radial camera seen only in framesets of two cameras
+//     can slide along its partner's axis, and within the plane of the axes
+//     if they are (nearly) coplanar, as in a ring.
 // An image agrees with a pose if both its own pose and that pose put >= 5 of
 // its scored inliers within max_radial_error_px and neither explains less
 // than half of what the other does. The hypothesis with the best truncated
 // radial score keeps its agreeing images, the framesets they determine and
-// the cameras with two of them; eq. 4 is minimized over those.
+// the cameras with two of them and a determined translation; eq. 4 is
+// minimized over those.
 //
 // Returns false (message in summary->message and the log) on inconsistent
 // input, on radial rigs with parallel principal axes, or if the reference

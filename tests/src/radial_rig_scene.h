@@ -32,7 +32,8 @@ struct RadialRigSceneOptions {
   // Gaussian noise on each pixel coordinate.
   double noise_px = 0;
   // Gaussian noise of the per-image radial poses: rotation about a random
-  // axis (degrees), tx and ty (map units).
+  // axis through the centroid of the image's map points (degrees), then tx
+  // and ty (map units).
   double pose_noise_deg = 0;
   double pose_noise_translation = 0;
   // Share of images mis-localized: a random pose, with correspondences (all
@@ -46,6 +47,10 @@ struct RadialRigSceneOptions {
   // Offset of the dataset cameras' principal points from the truth, pixels,
   // in a random direction per camera.
   double principal_point_error_px = 0;
+  // The cameras: SIMPLE_RADIAL (pinhole + k1), 640 x 480, focal length
+  // focal_length + 7 i px and k1 + 0.01 i for camera i.
+  double focal_length = 420;
+  double k1 = -0.12;
   unsigned int seed = 1;
 };
 
@@ -85,8 +90,13 @@ inline std::vector<Correspondence> MakeCorrespondences(
   std::vector<Correspondence> correspondences;
   while (static_cast<int>(correspondences.size()) < num_points) {
     // Normalized coordinates: exact projection through the camera model.
-    const Eigen::Vector2d normalized(1.6 * uniform(*random) - 0.8,
-                                     1.2 * uniform(*random) - 0.6);
+    // Normalized coordinates, drawn over more than the field of view (barrel
+    // distortion pulls them in) and kept if inside the image.
+    const Eigen::Vector2d normalized(
+        (2 * uniform(*random) - 1) * 0.65 * camera.Width() /
+            camera.MeanFocalLength(),
+        (2 * uniform(*random) - 1) * 0.65 * camera.Height() /
+            camera.MeanFocalLength());
     const Eigen::Vector2d pixel = camera.WorldToImage(normalized);
     if (pixel.x() < 5 || pixel.y() < 5 || pixel.x() > camera.Width() - 5 ||
         pixel.y() > camera.Height() - 5) {
@@ -138,10 +148,11 @@ inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
 
   for (int i = 0; i < num_cameras; ++i) {
     colmap::Camera camera;
-    camera.InitializeWithName("SIMPLE_RADIAL", 420 + 7 * i, 640, 480);
+    camera.InitializeWithName("SIMPLE_RADIAL", options.focal_length + 7 * i,
+                              640, 480);
     camera.SetPrincipalPointX(318.7 + 2.1 * i);
     camera.SetPrincipalPointY(242.3 - 1.7 * i);
-    camera.Params(3) = -0.12 + 0.01 * i;
+    camera.Params(3) = options.k1 + 0.01 * i;
     scene.truth.cameras.push_back(camera);
     scene.truth.cam_from_rig.push_back(cam_from_body[i] * body_from_rig);
     scene.truth.camera_calibrated.push_back(true);
@@ -199,21 +210,30 @@ inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
         cam_from_world =
             Rigid3d(RandomRotation(&random),
                     Eigen::Vector3d(3 * normal(random), 3 * normal(random), 0));
-      } else {
+      }
+      image.correspondences = MakeCorrespondences(
+          scene.truth.cameras[i], cam_from_world, options.points_per_image,
+          options.noise_px, &random);
+      if (!garbage) {
+        // A single-image pose errs about the points it sees: the rotation
+        // turns about their centroid, whose image stays put.
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (const Correspondence& correspondence : image.correspondences) {
+          centroid += correspondence.point3D / image.correspondences.size();
+        }
         const Eigen::Vector3d axis(normal(random), normal(random),
                                    normal(random));
+        const Eigen::Vector3d centroid_in_cam = cam_from_world * centroid;
         cam_from_world.rotation =
             RotationAbout(axis, options.pose_noise_deg * normal(random)) *
             cam_from_world.rotation;
+        cam_from_world.translation =
+            centroid_in_cam - cam_from_world.rotation * centroid;
         cam_from_world.translation.x() +=
             options.pose_noise_translation * normal(random);
         cam_from_world.translation.y() +=
             options.pose_noise_translation * normal(random);
       }
-      image.correspondences = MakeCorrespondences(
-          scene.truth.cameras[i],
-          garbage ? cam_from_world : true_cam_from_world,
-          options.points_per_image, options.noise_px, &random);
       if (!missing) {
         // The forward translation is unknown to a radial pose.
         cam_from_world.translation.z() = 10 * normal(random);

@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
-#include "src/radial_pose_solver.h"
 
 #include "tests/src/radial_rig_scene.h"
 
@@ -16,8 +14,6 @@ using testing::MakeRadialRigScene;
 using testing::RadialRigScene;
 using testing::RadialRigSceneOptions;
 using testing::RotationDistance;
-
-constexpr double kDegree = M_PI / 180.0;
 
 // The truth in the radial gauge of the estimate (NormalizeRadialRigOrigin);
 // its rotations and all radial projections are unchanged by that.
@@ -38,23 +34,6 @@ TEST(InitializeRig, ExactRadialPosesRecoverRig) {
   EXPECT_EQ(summary.num_framesets_assigned, 30);
   EXPECT_EQ(summary.num_images_consistent, 150);
   EXPECT_LT(summary.best_score, 1e-6);
-  {
-    const RigCalibration t = RadialTruth(scene);
-    double r = 0, tr = 0, q = 0;
-    for (int i = 0; i < 5; ++i) {
-      r = std::max(
-          r, RotationDistance(calibration.cam_from_rig[i], t.cam_from_rig[i]));
-      tr = std::max(tr, (calibration.cam_from_rig[i].translation -
-                         t.cam_from_rig[i].translation)
-                            .norm());
-    }
-    for (int j = 0; j < 30; ++j)
-      q = std::max(q, (calibration.rig_from_world[j]->ToMatrix() -
-                       t.rig_from_world[j]->ToMatrix())
-                          .norm());
-    std::cout << "MEASURE exact rot " << r << " trans " << tr << " rig " << q
-              << " trials " << summary.num_trials << std::endl;
-  }
 
   const RigCalibration truth = RadialTruth(scene);
   EXPECT_EQ(
@@ -188,85 +167,98 @@ TEST(InitializeRig, RobustToWrongAndMissingPosesWithoutCompleteFramesets) {
         << j;
   }
   EXPECT_GE(num_assigned, num_determinable - 1);
-  std::cout << "MEASURE rot_deg " << max_rotation_deg << " trans "
-            << max_translation << " assigned " << num_assigned
-            << " determinable " << num_determinable << " trials "
-            << summary.num_trials << " score " << summary.best_score
-            << " consistent " << summary.num_images_consistent << " localized "
-            << summary.num_images_localized << " garbage " << num_garbage
-            << std::endl;
-  for (int j = 0; j < 30; ++j)
-    if (calibration.rig_from_world[j])
-      std::cout << "MEASURE rig " << j << " "
-                << RotationDifferenceDeg(
-                       calibration.rig_from_world[j]->rotation,
-                       truth.rig_from_world[j]->rotation)
-                << " "
-                << (calibration.rig_from_world[j]->translation -
-                    truth.rig_from_world[j]->translation)
-                       .norm()
-                << std::endl;
   EXPECT_LE(summary.num_trials, 30);
 }
 
-TEST(InitializeRig, SweepSeeds) {
-  for (unsigned seed : {12u, 28u}) {
-    RadialRigSceneOptions o = HardOptions();
-    o.seed = seed;
-    const RadialRigScene scene = MakeRadialRigScene(o);
+// The hard case on 40 random scenes: every run places the reference camera,
+// every placed camera's rotation is accurate, and almost all cameras are
+// placed. The ring's axes are nearly coplanar, and a frameset of two
+// cameras constrains their offset only along the common normal of their
+// axes (nearly vertical here): a camera seen only in pairs is weakly placed
+// within the plane (translation errors of several cm) or, below the
+// conditioning limit, left out.
+TEST(InitializeRig, RobustAcrossRandomScenes) {
+  int num_placed = 0;
+  for (unsigned int seed = 1; seed <= 40; ++seed) {
+    RadialRigSceneOptions scene_options = HardOptions();
+    scene_options.seed = seed;
+    const RadialRigScene scene = MakeRadialRigScene(scene_options);
     RigCalibration calibration = scene.input;
     RigInitializerSummary summary;
-    for (int j = 0; j < 30; ++j) { std::cout << "FSET " << j << ":"; for (size_t k = 0; k < scene.dataset.images.size(); ++k) if (scene.dataset.images[k].frameset_index == j) std::cout << " " << scene.dataset.images[k].camera_index << (scene.garbage[k] ? "g" : (scene.input.images[k].single_image_cam_from_world ? "" : "m")); std::cout << std::endl; }
-    const bool ok = InitializeRig(RigInitializerOptions(), scene.dataset,
-                                  &calibration, &summary);
-    {
-      double sum = 0; int n = 0;
-      std::vector<int> good_in_det(5, 0);
-      for (size_t k = 0; k < scene.dataset.images.size(); ++k) {
-        const RigImage& image = scene.dataset.images[k];
-        if (!scene.input.images[k].single_image_cam_from_world) continue;
-        const Rigid3d pose = scene.truth.CamFromWorld(image.camera_index, image.frameset_index);
-        const Eigen::Vector2d pp(scene.dataset.cameras[image.camera_index].camera.PrincipalPointX(), scene.dataset.cameras[image.camera_index].camera.PrincipalPointY());
-        for (const auto& c : image.correspondences) { double e = std::min(8.0, RadialReprojectionError(pose, c.point2D - pp, c.point3D)); sum += e * e; ++n; }
-        if (scene.garbage[k]) continue;
-        int good = 0;
-        for (size_t m = 0; m < scene.dataset.images.size(); ++m) good += scene.dataset.images[m].frameset_index == image.frameset_index && scene.input.images[m].single_image_cam_from_world && !scene.garbage[m];
-        if (good >= 2) ++good_in_det[image.camera_index];
-      }
-      std::cout << "SWEEP seed " << seed << " truth score " << std::sqrt(sum / n) << " best " << summary.best_score << " good-in-determinable per cam " << good_in_det[0] << " " << good_in_det[1] << " " << good_in_det[2] << " " << good_in_det[3] << " " << good_in_det[4] << std::endl;
-    }
-    if (!ok) {
-      std::cout << "SWEEP seed " << seed << " FAILED" << std::endl;
-      continue;
-    }
+    ASSERT_TRUE(InitializeRig(RigInitializerOptions(), scene.dataset,
+                              &calibration, &summary))
+        << "scene " << seed << ": " << summary.message;
+    num_placed += summary.num_cameras_assigned;
     const RigCalibration truth = RadialTruth(scene);
-    double r = 0, t = 0, qr = 0, qt = 0;
-    int na = 0;
-    for (int i = 0; i < 5; ++i)
-      if (calibration.camera_calibrated[i]) {
-        r = std::max(r,
-                     RotationDifferenceDeg(calibration.cam_from_rig[i].rotation,
-                                           truth.cam_from_rig[i].rotation));
-        t = std::max(t, (calibration.cam_from_rig[i].translation -
-                         truth.cam_from_rig[i].translation)
-                            .norm());
-      }
-    for (int j = 0; j < 30; ++j)
-      if (calibration.rig_from_world[j]) {
-        ++na;
-        qr = std::max(
-            qr, RotationDifferenceDeg(calibration.rig_from_world[j]->rotation,
-                                      truth.rig_from_world[j]->rotation));
-        qt = std::max(qt, (calibration.rig_from_world[j]->translation -
-                           truth.rig_from_world[j]->translation)
-                              .norm());
-      }
-    for (int i = 0; i < 5; ++i) std::cout << "CAM " << i << " rot " << RotationDifferenceDeg(calibration.cam_from_rig[i].rotation, truth.cam_from_rig[i].rotation) << " t " << (calibration.cam_from_rig[i].translation - truth.cam_from_rig[i].translation).transpose() << std::endl;
-    std::cout << "SWEEP seed " << seed << " ok " << ok << " cams "
-              << summary.num_cameras_assigned << " rot " << r << " t " << t
-              << " rig " << na << " rigrot " << qr << " rigt " << qt
-              << " trials " << summary.num_trials << std::endl;
+    for (int i = 0; i < 5; ++i) {
+      if (!calibration.camera_calibrated[i]) continue;
+      EXPECT_LT(RotationDifferenceDeg(calibration.cam_from_rig[i].rotation,
+                                      truth.cam_from_rig[i].rotation),
+                0.1)
+          << "scene " << seed << " camera " << i;
+      EXPECT_LT((calibration.cam_from_rig[i].translation -
+                 truth.cam_from_rig[i].translation)
+                    .norm(),
+                0.15)
+          << "scene " << seed << " camera " << i;
+    }
+    for (int j = 0; j < 30; ++j) {
+      if (!calibration.rig_from_world[j]) continue;
+      EXPECT_LT(RotationDifferenceDeg(calibration.rig_from_world[j]->rotation,
+                                      truth.rig_from_world[j]->rotation),
+                0.2)
+          << "scene " << seed << " frameset " << j;
+    }
   }
+  EXPECT_GE(num_placed, 195);
+}
+
+// Camera 4 is only ever localized together with camera 0 alone: it can
+// slide along camera 0's axis without changing any radial projection, so it
+// must be left out rather than placed arbitrarily.
+TEST(InitializeRig, CameraSeenWithOnlyOnePartnerIsNotPlaced) {
+  RadialRigScene scene = MakeRadialRigScene(RadialRigSceneOptions());
+  for (size_t k = 0; k < scene.dataset.images.size(); ++k) {
+    const RigImage& image = scene.dataset.images[k];
+    const bool with_camera_4 = image.frameset_index >= 15;
+    if ((with_camera_4 && image.camera_index != 0 && image.camera_index != 4) ||
+        (!with_camera_4 && image.camera_index == 4)) {
+      scene.input.images[k].single_image_cam_from_world.reset();
+    }
+  }
+  RigCalibration calibration = scene.input;
+  RigInitializerSummary summary;
+  ASSERT_TRUE(InitializeRig(RigInitializerOptions(), scene.dataset,
+                            &calibration, &summary))
+      << summary.message;
+  EXPECT_EQ(summary.num_cameras_assigned, 4);
+  EXPECT_FALSE(calibration.camera_calibrated[4]);
+  const RigCalibration truth = RadialTruth(scene);
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(calibration.camera_calibrated[i]);
+    EXPECT_LT(
+        RotationDistance(calibration.cam_from_rig[i], truth.cam_from_rig[i]),
+        1e-8);
+  }
+
+  // With full poses the pairs do place it.
+  for (size_t k = 0; k < scene.dataset.images.size(); ++k) {
+    if (scene.input.images[k].single_image_cam_from_world) {
+      const RigImage& image = scene.dataset.images[k];
+      scene.input.images[k].single_image_cam_from_world =
+          scene.truth.CamFromWorld(image.camera_index, image.frameset_index);
+    }
+  }
+  calibration = scene.input;
+  RigInitializerOptions options;
+  options.radial = false;
+  ASSERT_TRUE(InitializeRig(options, scene.dataset, &calibration, &summary))
+      << summary.message;
+  ASSERT_TRUE(calibration.camera_calibrated[4]);
+  EXPECT_LT((calibration.cam_from_rig[4].ToMatrix() -
+             scene.truth.cam_from_rig[4].ToMatrix())
+                .norm(),
+            1e-8);
 }
 
 TEST(InitializeRig, DeterministicForSeed) {
