@@ -20,6 +20,9 @@ namespace {
 
 // An image with fewer inliers says little about its frameset's rig pose.
 constexpr int kMinInliersPerImage = 5;
+// After the first solve, an image whose correspondences are mostly beyond
+// max_radial_error_px is taken as mis-localized and dropped whole.
+constexpr double kMinInlierShare = 0.5;
 
 // Radial residual (RadialResidual) of one correspondence of camera i in
 // frameset j: the camera-frame point is P_i Q_j X, the observation is taken
@@ -76,28 +79,152 @@ Rigid3d FromParameters(const std::array<double, 6>& parameters) {
 
 // One correspondence in the adjustment.
 struct Observation {
+  int image;  // dataset image index
   int camera;
   int frameset;
   Eigen::Vector2d point2D;
   Eigen::Vector3d point3D;
 };
 
-double RmsRadialError(
-    const std::vector<Observation>& observations,
-    const std::vector<std::array<double, 6>>& cam_parameters,
-    const std::vector<std::array<double, 6>>& rig_parameters,
-    const std::vector<std::array<double, 2>>& principal_points) {
+// The adjusted quantities, as Ceres parameter blocks.
+struct Parameters {
+  std::vector<std::array<double, 6>> cam_from_rig;
+  std::vector<std::array<double, 6>> rig_from_world;
+  std::vector<std::array<double, 2>> principal_points;
+};
+
+// |pi_r(...) - (x - c)|: the radial reprojection error of an observation.
+double RadialError(const Observation& observation,
+                   const Parameters& parameters) {
+  double residual[2];
+  RadialRigCost(observation.point2D, observation.point3D)(
+      parameters.cam_from_rig[observation.camera].data(),
+      parameters.rig_from_world[observation.frameset].data(),
+      parameters.principal_points[observation.camera].data(), residual);
+  return std::hypot(residual[0], residual[1]);
+}
+
+double RmsRadialError(const std::vector<Observation>& observations,
+                      const Parameters& parameters) {
   if (observations.empty()) return 0;
   double sum_sq = 0;
   for (const Observation& observation : observations) {
-    double residual[2];
-    RadialRigCost(observation.point2D, observation.point3D)(
-        cam_parameters[observation.camera].data(),
-        rig_parameters[observation.frameset].data(),
-        principal_points[observation.camera].data(), residual);
-    sum_sq += residual[0] * residual[0] + residual[1] * residual[1];
+    const double error = RadialError(observation, parameters);
+    sum_sq += error * error;
   }
   return std::sqrt(sum_sq / observations.size());
+}
+
+// The observations of the framesets whose rig pose they determine. With
+// radial projections a rig pose's translation is determined iff
+// sum_k (I - z_k z_k^T) over the principal axes z_k (in the rig frame) of
+// the cameras observing it is regular; only cameras with
+// kMinInliersPerImage observations in the frameset count.
+std::vector<Observation> KeepDeterminedFramesets(
+    const std::vector<Observation>& observations,
+    const RigCalibration& calibration, double min_axis_eigenvalue) {
+  const int num_framesets = calibration.rig_from_world.size();
+  std::vector<std::vector<int>> count_of_camera(
+      num_framesets, std::vector<int>(calibration.cam_from_rig.size(), 0));
+  for (const Observation& observation : observations) {
+    ++count_of_camera[observation.frameset][observation.camera];
+  }
+  std::vector<char> determined(num_framesets, 0);
+  for (int j = 0; j < num_framesets; ++j) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    int num_cameras = 0;
+    for (size_t i = 0; i < count_of_camera[j].size(); ++i) {
+      if (count_of_camera[j][i] < kMinInliersPerImage) continue;
+      const Eigen::Vector3d axis =
+          calibration.cam_from_rig[i].RotationMatrix().row(2).transpose();
+      normal += Eigen::Matrix3d::Identity() - axis * axis.transpose();
+      ++num_cameras;
+    }
+    determined[j] =
+        num_cameras >= 2 && Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                normal, Eigen::EigenvaluesOnly)
+                                    .eigenvalues()(0) >= min_axis_eigenvalue;
+  }
+  std::vector<Observation> kept;
+  for (const Observation& observation : observations) {
+    if (determined[observation.frameset]) kept.push_back(observation);
+  }
+  return kept;
+}
+
+// One Levenberg-Marquardt solve over the observations. Gauge: the reference
+// camera's pose is constant, every camera's tz is held, and so is the t_z of
+// one rig pose (the rig origin's slide along the reference axis moves every
+// rig pose's t_z; holding one removes that null direction). Rig poses form
+// the eliminated group of the Schur complement: no residual links two.
+ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
+                             const std::vector<Observation>& observations,
+                             int reference_camera, Parameters* parameters) {
+  const int num_cameras = parameters->cam_from_rig.size();
+  const int num_framesets = parameters->rig_from_world.size();
+  ceres::Problem problem;
+  ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
+  std::vector<char> cam_added(num_cameras, 0);
+  std::vector<char> rig_added(num_framesets, 0);
+  for (const Observation& observation : observations) {
+    problem.AddResidualBlock(
+        RadialRigCost::Create(observation.point2D, observation.point3D), loss,
+        parameters->cam_from_rig[observation.camera].data(),
+        parameters->rig_from_world[observation.frameset].data(),
+        parameters->principal_points[observation.camera].data());
+    cam_added[observation.camera] = 1;
+    rig_added[observation.frameset] = 1;
+  }
+
+  auto* ordering = new ceres::ParameterBlockOrdering;
+  bool tz_gauge_held = false;
+  for (int j = 0; j < num_framesets; ++j) {
+    if (!rig_added[j]) continue;
+    ordering->AddElementToGroup(parameters->rig_from_world[j].data(), 0);
+    if (!tz_gauge_held) {
+      problem.SetManifold(parameters->rig_from_world[j].data(),
+                          new ceres::SubsetManifold(6, {5}));
+      tz_gauge_held = true;
+    }
+  }
+  for (int i = 0; i < num_cameras; ++i) {
+    if (!cam_added[i]) continue;
+    ordering->AddElementToGroup(parameters->cam_from_rig[i].data(), 1);
+    ordering->AddElementToGroup(parameters->principal_points[i].data(), 1);
+    if (i == reference_camera) {
+      problem.SetParameterBlockConstant(parameters->cam_from_rig[i].data());
+    } else {
+      problem.SetManifold(parameters->cam_from_rig[i].data(),
+                          new ceres::SubsetManifold(6, {5}));
+    }
+    if (!options.refine_principal_points) {
+      problem.SetParameterBlockConstant(parameters->principal_points[i].data());
+    }
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering.reset(ordering);
+  solver_options.max_num_iterations = options.max_num_iterations;
+  // Noisy problems stop on the relative cost change (Ceres' default 1e-6);
+  // this lets exact ones converge to the last digits of map-unit poses.
+  solver_options.parameter_tolerance = 1e-10;
+  solver_options.num_threads =
+      colmap::GetEffectiveNumThreads(options.num_threads);
+  solver_options.minimizer_progress_to_stdout = options.print_progress;
+  solver_options.logging_type =
+      options.print_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(solver_options, &problem, &solver_summary);
+  return solver_summary;
+}
+
+bool ObservesReference(const std::vector<Observation>& observations,
+                       int reference_camera) {
+  for (const Observation& observation : observations) {
+    if (observation.camera == reference_camera) return true;
+  }
+  return false;
 }
 
 bool Fail(const std::string& message, RadialBundleAdjustmentSummary* summary) {
@@ -177,20 +304,22 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   if (calibration == nullptr) return Fail("no calibration given", summary);
   const std::string error = CheckInput(dataset, *calibration);
   if (!error.empty()) return Fail(error, summary);
-  if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0) {
-    return Fail("loss_scale_px must be positive, max_num_iterations >= 0",
-                summary);
+  if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0 ||
+      !(options.max_radial_error_px >= 0)) {
+    return Fail(
+        "loss_scale_px must be positive, max_num_iterations and "
+        "max_radial_error_px non-negative",
+        summary);
   }
-
   const int num_cameras = dataset.cameras.size();
   const int num_framesets = dataset.frameset_names.size();
   const int reference = dataset.reference_camera;
+  const double min_axis_eigenvalue =
+      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
 
   // Inlier correspondences of images of calibrated cameras in posed
-  // framesets, and per frameset the principal axes (in the rig frame) of the
-  // cameras that observe enough of them.
-  std::vector<std::vector<Observation>> observations_of_frameset(num_framesets);
-  std::vector<std::vector<Eigen::Vector3d>> axes_of_frameset(num_framesets);
+  // framesets that their observations determine.
+  std::vector<Observation> candidates;
   for (size_t k = 0; k < dataset.images.size(); ++k) {
     const RigImage& image = dataset.images[k];
     const std::vector<char>& mask = calibration->images[k].inlier_mask;
@@ -198,154 +327,121 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
         !calibration->rig_from_world[image.frameset_index]) {
       continue;
     }
-    int num_inliers = 0;
     for (size_t c = 0; c < mask.size(); ++c) {
-      if (!mask[c]) continue;
-      observations_of_frameset[image.frameset_index].push_back(
-          {image.camera_index, image.frameset_index,
-           image.correspondences[c].point2D, image.correspondences[c].point3D});
-      ++num_inliers;
-    }
-    if (num_inliers >= kMinInliersPerImage) {
-      axes_of_frameset[image.frameset_index].push_back(
-          calibration->cam_from_rig[image.camera_index]
-              .RotationMatrix()
-              .row(2)
-              .transpose());
+      if (mask[c]) {
+        candidates.push_back({static_cast<int>(k), image.camera_index,
+                              image.frameset_index,
+                              image.correspondences[c].point2D,
+                              image.correspondences[c].point3D});
+      }
     }
   }
-  const double min_axis_eigenvalue =
-      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
-  std::vector<Observation> observations;
-  int num_skipped = 0;
-  for (int j = 0; j < num_framesets; ++j) {
-    if (!calibration->rig_from_world[j]) continue;
-    // With radial projections the translation of Q_j is determined iff
-    // sum_k (I - z_k z_k^T) over the observing cameras' axes is regular.
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    for (const Eigen::Vector3d& axis : axes_of_frameset[j]) {
-      normal += Eigen::Matrix3d::Identity() - axis * axis.transpose();
-    }
-    const double smallest_eigenvalue =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normal,
-                                                       Eigen::EigenvaluesOnly)
-            .eigenvalues()(0);
-    if (axes_of_frameset[j].size() < 2 ||
-        smallest_eigenvalue < min_axis_eigenvalue) {
-      ++num_skipped;
-      continue;
-    }
-    observations.insert(observations.end(), observations_of_frameset[j].begin(),
-                        observations_of_frameset[j].end());
-  }
-  bool reference_observed = false;
-  for (const Observation& observation : observations) {
-    reference_observed |= observation.camera == reference;
-  }
-  if (!reference_observed) {
-    return Fail("the reference camera " + dataset.cameras[reference].name +
-                    " has no inlier correspondences in framesets with a "
-                    "determined rig pose",
-                summary);
+  std::vector<Observation> observations =
+      KeepDeterminedFramesets(candidates, *calibration, min_axis_eigenvalue);
+  const std::string no_reference_message =
+      "the reference camera " + dataset.cameras[reference].name +
+      " has no inlier correspondences in framesets with a determined rig pose";
+  if (!ObservesReference(observations, reference)) {
+    return Fail(no_reference_message, summary);
   }
 
-  std::vector<std::array<double, 6>> cam_parameters(num_cameras);
-  std::vector<std::array<double, 2>> principal_points(num_cameras);
+  Parameters parameters;
+  parameters.cam_from_rig.resize(num_cameras);
+  parameters.principal_points.resize(num_cameras);
   for (int i = 0; i < num_cameras; ++i) {
-    cam_parameters[i] = ToParameters(calibration->cam_from_rig[i]);
-    principal_points[i] = {calibration->cameras[i].PrincipalPointX(),
-                           calibration->cameras[i].PrincipalPointY()};
+    parameters.cam_from_rig[i] = ToParameters(calibration->cam_from_rig[i]);
+    parameters.principal_points[i] = {
+        calibration->cameras[i].PrincipalPointX(),
+        calibration->cameras[i].PrincipalPointY()};
   }
-  std::vector<std::array<double, 6>> rig_parameters(num_framesets);
+  parameters.rig_from_world.resize(num_framesets);
   for (int j = 0; j < num_framesets; ++j) {
     if (calibration->rig_from_world[j]) {
-      rig_parameters[j] = ToParameters(*calibration->rig_from_world[j]);
+      parameters.rig_from_world[j] =
+          ToParameters(*calibration->rig_from_world[j]);
     }
   }
+  const double initial_rms = RmsRadialError(observations, parameters);
 
-  ceres::Problem problem;
-  ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
-  std::vector<char> cam_added(num_cameras, 0);
-  std::vector<char> rig_added(num_framesets, 0);
-  for (const Observation& observation : observations) {
-    problem.AddResidualBlock(
-        RadialRigCost::Create(observation.point2D, observation.point3D), loss,
-        cam_parameters[observation.camera].data(),
-        rig_parameters[observation.frameset].data(),
-        principal_points[observation.camera].data());
-    cam_added[observation.camera] = 1;
-    rig_added[observation.frameset] = 1;
-  }
-
-  // Rig poses form the eliminated group: no residual links two of them.
-  auto* ordering = new ceres::ParameterBlockOrdering;
-  bool tz_gauge_held = false;
-  for (int j = 0; j < num_framesets; ++j) {
-    if (!rig_added[j]) continue;
-    ordering->AddElementToGroup(rig_parameters[j].data(), 0);
-    if (!tz_gauge_held) {
-      // The rig origin's slide along the reference axis moves every rig
-      // pose's t_z; holding one removes that null direction.
-      problem.SetManifold(rig_parameters[j].data(),
-                          new ceres::SubsetManifold(6, {5}));
-      tz_gauge_held = true;
+  // The Cauchy loss bounds the pull of each wrong correspondence, but the
+  // correspondences of a mis-localized image agree with one another, and a
+  // principal point shift is nearly a pan/tilt of the camera, a weakly
+  // constrained direction in which small coherent pulls add up. So after a
+  // first solve, the images with fewer than kMinInlierShare of their
+  // correspondences within max_radial_error_px are dropped whole (a few of a
+  // wrong image's points always fall near the predicted lines), the
+  // remaining correspondences beyond it too, and the rest solved again.
+  ceres::Solver::Summary solver_summary =
+      Solve(options, observations, reference, &parameters);
+  int num_iterations = solver_summary.iterations.size();
+  int num_outliers = 0;
+  if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
+    std::vector<char> within(observations.size(), 0);
+    std::vector<int> num_selected(dataset.images.size(), 0);
+    std::vector<int> num_within(dataset.images.size(), 0);
+    for (size_t n = 0; n < observations.size(); ++n) {
+      within[n] = RadialError(observations[n], parameters) <=
+                  options.max_radial_error_px;
+      ++num_selected[observations[n].image];
+      num_within[observations[n].image] += within[n];
+    }
+    std::vector<Observation> inliers;
+    for (size_t n = 0; n < observations.size(); ++n) {
+      const int image = observations[n].image;
+      if (within[n] &&
+          num_within[image] >= kMinInlierShare * num_selected[image]) {
+        inliers.push_back(observations[n]);
+      }
+    }
+    num_outliers = observations.size() - inliers.size();
+    if (num_outliers > 0) {
+      observations =
+          KeepDeterminedFramesets(inliers, *calibration, min_axis_eigenvalue);
+      if (!ObservesReference(observations, reference)) {
+        return Fail(no_reference_message + " after removing outliers", summary);
+      }
+      solver_summary = Solve(options, observations, reference, &parameters);
+      num_iterations += solver_summary.iterations.size();
     }
   }
-  for (int i = 0; i < num_cameras; ++i) {
-    if (!cam_added[i]) continue;
-    ordering->AddElementToGroup(cam_parameters[i].data(), 1);
-    ordering->AddElementToGroup(principal_points[i].data(), 1);
-    if (i == reference) {
-      problem.SetParameterBlockConstant(cam_parameters[i].data());
-    } else {
-      problem.SetManifold(cam_parameters[i].data(),
-                          new ceres::SubsetManifold(6, {5}));
-    }
-    if (!options.refine_principal_points) {
-      problem.SetParameterBlockConstant(principal_points[i].data());
-    }
-  }
-
-  const double initial_rms = RmsRadialError(observations, cam_parameters,
-                                            rig_parameters, principal_points);
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering.reset(ordering);
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = 1e-10;
-  solver_options.parameter_tolerance = 1e-10;
-  solver_options.num_threads =
-      colmap::GetEffectiveNumThreads(options.num_threads);
-  solver_options.minimizer_progress_to_stdout = options.print_progress;
-  solver_options.logging_type =
-      options.print_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-  ceres::Solver::Summary solver_summary;
-  ceres::Solve(solver_options, &problem, &solver_summary);
   if (!solver_summary.IsSolutionUsable()) {
     return Fail("the solver failed: " + solver_summary.message, summary);
   }
 
+  // Write back what the final solve adjusted.
+  std::vector<char> cam_adjusted(num_cameras, 0);
+  std::vector<char> rig_adjusted(num_framesets, 0);
+  for (const Observation& observation : observations) {
+    cam_adjusted[observation.camera] = 1;
+    rig_adjusted[observation.frameset] = 1;
+  }
   for (int i = 0; i < num_cameras; ++i) {
-    if (!cam_added[i]) continue;
-    calibration->cam_from_rig[i] = FromParameters(cam_parameters[i]);
+    if (!cam_adjusted[i]) continue;
+    calibration->cam_from_rig[i] = FromParameters(parameters.cam_from_rig[i]);
     calibration->cam_from_rig[i].translation.z() = 0;
-    calibration->cameras[i].SetPrincipalPointX(principal_points[i][0]);
-    calibration->cameras[i].SetPrincipalPointY(principal_points[i][1]);
+    calibration->cameras[i].SetPrincipalPointX(
+        parameters.principal_points[i][0]);
+    calibration->cameras[i].SetPrincipalPointY(
+        parameters.principal_points[i][1]);
   }
   calibration->cam_from_rig[reference] = Rigid3d();
+  int num_skipped = 0;
   for (int j = 0; j < num_framesets; ++j) {
-    if (rig_added[j]) {
-      calibration->rig_from_world[j] = FromParameters(rig_parameters[j]);
+    if (rig_adjusted[j]) {
+      calibration->rig_from_world[j] =
+          FromParameters(parameters.rig_from_world[j]);
+    } else if (calibration->rig_from_world[j]) {
+      ++num_skipped;
     }
   }
   NormalizeRadialRigOrigin(reference, calibration);
 
   if (summary) {
     summary->initial_rms_px = initial_rms;
-    summary->final_rms_px = RmsRadialError(observations, cam_parameters,
-                                           rig_parameters, principal_points);
+    summary->final_rms_px = RmsRadialError(observations, parameters);
     summary->num_residuals = observations.size();
-    summary->num_iterations = solver_summary.iterations.size();
+    summary->num_outliers = num_outliers;
+    summary->num_iterations = num_iterations;
     summary->num_framesets_skipped = num_skipped;
     summary->seconds = std::chrono::duration<double>(
                            std::chrono::steady_clock::now() - start_time)

@@ -26,20 +26,29 @@ struct RadialBundleAdjustmentOptions {
   // two cameras whose principal axes differ by at least this angle: with
   // radial projections, fewer do not determine the rig pose.
   double min_principal_axis_angle_deg = 5.0;
+  // After a first solve, correspondences with a larger radial error (pixels)
+  // are dropped, and images with fewer than half of theirs within it are
+  // dropped whole; the rest is solved again. The Cauchy loss bounds each
+  // wrong correspondence's pull, but those of a mis-localized image agree
+  // with one another and add up along the weakly constrained
+  // principal point / pan-tilt direction. 0: keep all.
+  double max_radial_error_px = 8.0;
   int num_threads = -1;
   bool print_progress = false;  // Ceres per-iteration progress on stdout
 };
 
 struct RadialBundleAdjustmentSummary {
-  // Radial reprojection RMS over the adjusted correspondences, pixels,
-  // before and after (no robust loss).
+  // Radial reprojection RMS (no robust loss), pixels: before, over all
+  // selected correspondences; after, over those kept (num_residuals).
   double initial_rms_px = 0;
   double final_rms_px = 0;
-  int num_residuals = 0;  // correspondences (2 residual components each)
-  int num_iterations = 0;
+  int num_residuals = 0;   // correspondences (2 residual components each)
+  int num_outliers = 0;    // correspondences dropped (max_radial_error_px)
+  int num_iterations = 0;  // of both solves
   double seconds = 0;
   // Framesets with a rig pose that their images do not determine (see
-  // min_principal_axis_angle_deg); their rig pose is left as it was.
+  // min_principal_axis_angle_deg) in the final solve; their rig pose is left
+  // as it was (or as the first solve left it).
   int num_framesets_skipped = 0;
   std::string message;  // why AdjustRadialRig failed; empty on success
 };
@@ -53,10 +62,13 @@ struct RadialBundleAdjustmentSummary {
 // of images of calibrated cameras whose frameset has a rig pose; the
 // observed points are centered on calibration->cameras[i]'s principal point.
 // Rig poses are eliminated first (Schur complement); Ceres runs on
-// num_threads threads. Returns false, with calibration unchanged and the
-// reason in summary->message and the log, on inconsistent input, if the
-// reference camera has no correspondences, or if the solver fails. summary
-// may be null.
+// num_threads threads. Correspondences with a radial error above
+// max_radial_error_px after a first solve, and mostly-outlier images, are
+// dropped for a second one.
+// Returns false, with calibration unchanged and the reason in
+// summary->message and the log, on inconsistent input, if the reference
+// camera has no correspondences, or if the solver fails. summary may be
+// null.
 bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
                      const RigDataset& dataset, RigCalibration* calibration,
                      RadialBundleAdjustmentSummary* summary);
