@@ -13,7 +13,7 @@ set -euo pipefail
 [[ $# -ge 1 ]] || { echo "usage: $0 BUILD_DIR [WORK_DIR]" >&2; exit 2; }
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="$(cd "$1" && pwd)"
-work="${2:-$(mktemp -d "${TMPDIR:-/tmp}/rendered_rig_e2e.XXXXXX")}"
+work="${2:-$(mktemp -d)}"
 fail() { echo "[e2e] FAILED: $*" >&2; echo "[e2e] outputs kept in $work" >&2; exit 1; }
 
 DEMO_SKIP_BUILD=1 RIG_CALIBRATOR_BUILD_DIR="$build" DEMO_PRESET=ring5 \
