@@ -9,8 +9,9 @@
 #   5. compares the calibration with the true rig.
 # Prints the time of every step and where the outputs are.
 #
-# Usage: scripts/demo.sh [OUTPUT_DIR]   (default: demo_output/ in the
-#                                        repository; must not exist or be empty)
+# Usage: scripts/demo.sh [OUTPUT_DIR]   (default: demo_output/rendered/ in the
+#   repository; must be new, empty or an earlier output of this demo, which
+#   is replaced)
 # Environment:
 #   DEMO_PRESET      rig: ring5 (default), fisheye_helmet5, car_surround4,
 #                    stereo_pair
@@ -23,7 +24,7 @@
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-out="${1:-$repo/demo_output}"
+out="${1:-$repo/demo_output/rendered}"
 preset="${DEMO_PRESET:-ring5}"
 scene="${DEMO_SCENE:-room}"
 seed="${DEMO_SEED:-0}"
@@ -34,10 +35,17 @@ rig_calibrator="$build/rig_calibrator"
 
 die() { echo "[demo] ERROR: $*" >&2; exit 1; }
 
+# A folder this demo wrote before (it holds the marker file) is replaced; any
+# other non-empty folder is left alone.
+marker=".rig_calibrator_demo"
 if [[ -e "$out" && -n "$(ls -A "$out" 2>/dev/null)" ]]; then
-  die "$out exists and is not empty; remove it or give another OUTPUT_DIR"
+  [[ -f "$out/$marker" ]] ||
+    die "$out exists, is not empty and was not written by this demo; remove it or give another OUTPUT_DIR"
+  echo "[demo] replacing the previous demo output in $out"
+  find "$out" -mindepth 1 -delete
 fi
 out="$(mkdir -p "$out" && cd "$out" && pwd)"
+touch "$out/$marker"
 
 demo_start=$SECONDS
 timings=()

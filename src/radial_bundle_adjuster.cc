@@ -60,23 +60,6 @@ class RadialRigCost {
   const Eigen::Vector3d point3D_;
 };
 
-std::array<double, 6> ToParameters(const Rigid3d& pose) {
-  std::array<double, 6> parameters;
-  const double quaternion[4] = {pose.rotation.w(), pose.rotation.x(),
-                                pose.rotation.y(), pose.rotation.z()};
-  ceres::QuaternionToAngleAxis(quaternion, parameters.data());
-  for (int r = 0; r < 3; ++r) parameters[3 + r] = pose.translation(r);
-  return parameters;
-}
-
-Rigid3d FromParameters(const std::array<double, 6>& parameters) {
-  double quaternion[4];
-  ceres::AngleAxisToQuaternion(parameters.data(), quaternion);
-  return Rigid3d(Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2],
-                                    quaternion[3]),
-                 Eigen::Vector3d(parameters[3], parameters[4], parameters[5]));
-}
-
 // One correspondence in the adjustment.
 struct Observation {
   int image;  // dataset image index
@@ -349,7 +332,8 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   parameters.cam_from_rig.resize(num_cameras);
   parameters.principal_points.resize(num_cameras);
   for (int i = 0; i < num_cameras; ++i) {
-    parameters.cam_from_rig[i] = ToParameters(calibration->cam_from_rig[i]);
+    parameters.cam_from_rig[i] =
+        ToAngleAxisTranslation(calibration->cam_from_rig[i]);
     parameters.principal_points[i] = {
         calibration->cameras[i].PrincipalPointX(),
         calibration->cameras[i].PrincipalPointY()};
@@ -358,7 +342,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   for (int j = 0; j < num_framesets; ++j) {
     if (calibration->rig_from_world[j]) {
       parameters.rig_from_world[j] =
-          ToParameters(*calibration->rig_from_world[j]);
+          ToAngleAxisTranslation(*calibration->rig_from_world[j]);
     }
   }
   const double initial_rms = RmsRadialError(observations, parameters);
@@ -417,7 +401,8 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   }
   for (int i = 0; i < num_cameras; ++i) {
     if (!cam_adjusted[i]) continue;
-    calibration->cam_from_rig[i] = FromParameters(parameters.cam_from_rig[i]);
+    calibration->cam_from_rig[i] =
+        FromAngleAxisTranslation(parameters.cam_from_rig[i]);
     calibration->cam_from_rig[i].translation.z() = 0;
     calibration->cameras[i].SetPrincipalPointX(
         parameters.principal_points[i][0]);
@@ -429,7 +414,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   for (int j = 0; j < num_framesets; ++j) {
     if (rig_adjusted[j]) {
       calibration->rig_from_world[j] =
-          FromParameters(parameters.rig_from_world[j]);
+          FromAngleAxisTranslation(parameters.rig_from_world[j]);
     } else if (calibration->rig_from_world[j]) {
       ++num_skipped;
     }

@@ -746,24 +746,6 @@ Hypothesis MakeHypothesis(const InitProblem& problem, int seed_frameset) {
   return hypothesis;
 }
 
-// Rigid3d <-> (angle-axis, translation) parameter blocks for Ceres.
-std::array<double, 6> ToParameters(const Rigid3d& pose) {
-  std::array<double, 6> parameters;
-  const double quaternion[4] = {pose.rotation.w(), pose.rotation.x(),
-                                pose.rotation.y(), pose.rotation.z()};
-  ceres::QuaternionToAngleAxis(quaternion, parameters.data());
-  for (int r = 0; r < 3; ++r) parameters[3 + r] = pose.translation(r);
-  return parameters;
-}
-
-Rigid3d FromParameters(const std::array<double, 6>& parameters) {
-  double quaternion[4];
-  ceres::AngleAxisToQuaternion(parameters.data(), quaternion);
-  return Rigid3d(Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2],
-                                    quaternion[3]),
-                 Eigen::Vector3d(parameters[3], parameters[4], parameters[5]));
-}
-
 // d(T, P Q) of eq. 4 as a residual vector: the angle-axis vector of
 // R_T^T R_P R_Q (3, radians), then translation_weight times the difference
 // of the camera-frame positions of the image's scene center X,
@@ -833,12 +815,13 @@ void MinimizePoseDeviation(const InitProblem& problem,
   std::vector<std::array<double, 6>> rig_parameters(problem.num_framesets);
   for (int i = 0; i < problem.num_cameras; ++i) {
     if (hypothesis->cam_from_rig[i]) {
-      cam_parameters[i] = ToParameters(*hypothesis->cam_from_rig[i]);
+      cam_parameters[i] = ToAngleAxisTranslation(*hypothesis->cam_from_rig[i]);
     }
   }
   for (int j = 0; j < problem.num_framesets; ++j) {
     if (hypothesis->rig_from_world[j]) {
-      rig_parameters[j] = ToParameters(*hypothesis->rig_from_world[j]);
+      rig_parameters[j] =
+          ToAngleAxisTranslation(*hypothesis->rig_from_world[j]);
     }
   }
 
@@ -901,12 +884,13 @@ void MinimizePoseDeviation(const InitProblem& problem,
   }
   for (int i = 0; i < problem.num_cameras; ++i) {
     if (cam_added[i]) {
-      hypothesis->cam_from_rig[i] = FromParameters(cam_parameters[i]);
+      hypothesis->cam_from_rig[i] = FromAngleAxisTranslation(cam_parameters[i]);
     }
   }
   for (int j = 0; j < problem.num_framesets; ++j) {
     if (rig_added[j]) {
-      hypothesis->rig_from_world[j] = FromParameters(rig_parameters[j]);
+      hypothesis->rig_from_world[j] =
+          FromAngleAxisTranslation(rig_parameters[j]);
     }
   }
 }

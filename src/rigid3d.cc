@@ -1,5 +1,7 @@
 #include "src/rigid3d.h"
 
+#include <ceres/rotation.h>
+
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -45,6 +47,23 @@ Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {
   d(2, 2) =
       (svd.matrixU() * svd.matrixV().transpose()).determinant() > 0 ? 1 : -1;
   return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+std::array<double, 6> ToAngleAxisTranslation(const Rigid3d& pose) {
+  std::array<double, 6> parameters;
+  const double quaternion[4] = {pose.rotation.w(), pose.rotation.x(),
+                                pose.rotation.y(), pose.rotation.z()};
+  ceres::QuaternionToAngleAxis(quaternion, parameters.data());
+  for (int r = 0; r < 3; ++r) parameters[3 + r] = pose.translation(r);
+  return parameters;
+}
+
+Rigid3d FromAngleAxisTranslation(const std::array<double, 6>& parameters) {
+  double quaternion[4];
+  ceres::AngleAxisToQuaternion(parameters.data(), quaternion);
+  return Rigid3d(Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2],
+                                    quaternion[3]),
+                 Eigen::Vector3d(parameters[3], parameters[4], parameters[5]));
 }
 
 }  // namespace rig_calibrator

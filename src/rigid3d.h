@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 
 namespace rig_calibrator {
 
@@ -48,6 +49,11 @@ Rigid3d operator*(const Rigid3d& a_from_b, const Rigid3d& b_from_c);
 // Angle of R_a^T R_b in degrees.
 double RotationDifferenceDeg(const Eigen::Quaterniond& a,
                              const Eigen::Quaterniond& b);
+
+// A pose as one Ceres parameter block: (angle-axis of the rotation,
+// translation), the minimal 6-vector that the bundle adjusters optimize.
+std::array<double, 6> ToAngleAxisTranslation(const Rigid3d& pose);
+Rigid3d FromAngleAxisTranslation(const std::array<double, 6>& parameters);
 
 // Projects a 3x3 matrix onto the closest rotation in Frobenius norm
 // (SVD, with the determinant forced to +1).

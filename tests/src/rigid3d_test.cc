@@ -51,5 +51,17 @@ TEST(Rigid3d, NearestRotationOfNoisyRotation) {
   EXPECT_NEAR(NearestRotation(reflection).determinant(), 1.0, 1e-12);
 }
 
+TEST(Rigid3d, AngleAxisTranslationRoundTrip) {
+  const Rigid3d pose = RandomTransform(7);
+  const std::array<double, 6> parameters = ToAngleAxisTranslation(pose);
+  const Eigen::Vector3d angle_axis(parameters[0], parameters[1],
+                                   parameters[2]);
+  EXPECT_NEAR(angle_axis.norm(), Eigen::AngleAxisd(pose.rotation).angle(),
+              1e-12);
+  const Rigid3d back = FromAngleAxisTranslation(parameters);
+  EXPECT_LT(RotationDifferenceDeg(back.rotation, pose.rotation), 1e-9);
+  EXPECT_LT((back.translation - pose.translation).norm(), 1e-15);
+}
+
 }  // namespace
 }  // namespace rig_calibrator
