@@ -58,6 +58,27 @@ bool ModelFilesExist(const std::string& folder, const std::string& extension) {
   return true;
 }
 
+// Moves the map points that the final bundle adjustment refined. A run from
+// a correspondence file has no map points to move: its model has cameras and
+// images only.
+bool MoveRefinedPoints(const RigCalibration& calibration,
+                       colmap::Reconstruction* model, std::string* error) {
+  if (model->NumPoints3D() == 0) {
+    return true;
+  }
+  for (const auto& [point3D_id, xyz] : calibration.refined_points3D) {
+    if (point3D_id < 0 ||
+        !model->ExistsPoint3D(static_cast<colmap::point3D_t>(point3D_id)) ||
+        !xyz.allFinite()) {
+      *error = "the refined point " + std::to_string(point3D_id) +
+               " is not a map point or not finite";
+      return false;
+    }
+    model->Point3D(static_cast<colmap::point3D_t>(point3D_id)).SetXYZ(xyz);
+  }
+  return true;
+}
+
 }  // namespace
 
 bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
@@ -100,15 +121,8 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
 
   rig_model->model = map;
   colmap::Reconstruction& model = rig_model->model;
-  for (const auto& [point3D_id, xyz] : calibration.refined_points3D) {
-    if (point3D_id < 0 ||
-        !model.ExistsPoint3D(static_cast<colmap::point3D_t>(point3D_id)) ||
-        !xyz.allFinite()) {
-      *error = "the refined point " + std::to_string(point3D_id) +
-               " is not a map point or not finite";
-      return false;
-    }
-    model.Point3D(static_cast<colmap::point3D_t>(point3D_id)).SetXYZ(xyz);
+  if (!MoveRefinedPoints(calibration, &model, error)) {
+    return false;
   }
 
   // The rig frame is the reference camera's frame: cam_from_ref =

@@ -26,29 +26,12 @@ std::string FormatYamlFloat(double value) {
   return text;
 }
 
-bool ParseDouble(std::string_view text, double* value) {
-  // from_chars rejects a leading '+', which some writers emit.
-  if (!text.empty() && text.front() == '+') {
-    text.remove_prefix(1);
-    if (!text.empty() && text.front() == '-') {
-      return false;
-    }
-  }
-  if (text.empty()) {
-    return false;
-  }
-  double parsed = 0;
-  const std::from_chars_result result =
-      std::from_chars(text.data(), text.data() + text.size(), parsed);
-  if (result.ec != std::errc() || result.ptr != text.data() + text.size() ||
-      !std::isfinite(parsed)) {
-    return false;
-  }
-  *value = parsed;
-  return true;
-}
+namespace {
 
-bool ParseInt64(std::string_view text, int64_t* value) {
+// std::from_chars of the whole text; it rejects a leading '+', which some
+// writers emit, so that is dropped first (but not "+-").
+template <typename Number>
+bool ParseWholeNumber(std::string_view text, Number* value) {
   if (!text.empty() && text.front() == '+') {
     text.remove_prefix(1);
     if (!text.empty() && text.front() == '-') {
@@ -58,7 +41,7 @@ bool ParseInt64(std::string_view text, int64_t* value) {
   if (text.empty()) {
     return false;
   }
-  int64_t parsed = 0;
+  Number parsed = 0;
   const std::from_chars_result result =
       std::from_chars(text.data(), text.data() + text.size(), parsed);
   if (result.ec != std::errc() || result.ptr != text.data() + text.size()) {
@@ -66,6 +49,21 @@ bool ParseInt64(std::string_view text, int64_t* value) {
   }
   *value = parsed;
   return true;
+}
+
+}  // namespace
+
+bool ParseDouble(std::string_view text, double* value) {
+  double parsed = 0;
+  if (!ParseWholeNumber(text, &parsed) || !std::isfinite(parsed)) {
+    return false;
+  }
+  *value = parsed;
+  return true;
+}
+
+bool ParseInt64(std::string_view text, int64_t* value) {
+  return ParseWholeNumber(text, value);
 }
 
 }  // namespace rig_calibrator

@@ -22,6 +22,11 @@
 #   MAP_MIN_REGISTERED     fraction of images the mapper must register
 #                          (default 0.8)
 #   MAP_ALIGN_MAX_ERROR    alignment inlier threshold in meters (default 0.1)
+#   MAP_SCALE_DISTANCE     "IMAGE_A IMAGE_B DISTANCE": scale the map (about
+#                          its origin) so that the camera centers of these two
+#                          map images are DISTANCE apart (a measured distance,
+#                          e.g. between two tripod positions); instead of
+#                          REF_POSITIONS
 #   MAP_NUM_THREADS        threads for every step (default: all cores)
 set -euo pipefail
 
@@ -40,17 +45,8 @@ camera_params="${4:-}"
 
 die() { echo "[build_map] ERROR: $*" >&2; exit 1; }
 
-default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
-if [[ -n "${COLMAP:-}" ]]; then
-  colmap="$COLMAP"
-elif [[ -x "$default_colmap" ]]; then
-  colmap="$default_colmap"
-elif command -v colmap > /dev/null; then
-  colmap="$(command -v colmap)"
-else
-  die "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
-fi
-[[ -x "$colmap" ]] || die "COLMAP=$colmap is not executable"
+# shellcheck source=find_colmap.sh
+source "$(dirname "${BASH_SOURCE[0]}")/find_colmap.sh"
 
 matcher="${MAP_MATCHER:-sequential}"
 overlap="${MAP_OVERLAP:-8}"
@@ -148,8 +144,52 @@ if ! awk -v n="$best_count" -v total="$num_images" -v min="$min_registered" \
   die "only $best_count of $num_images images registered (MAP_MIN_REGISTERED=$min_registered)"
 fi
 
+# The camera center of a map image, -R^T t, from a text model's images.txt
+# (IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, then a line of points).
+camera_center() {
+  awk -v name="$2" '
+    /^#/ { next }
+    !odd && $10 == name {
+      w = $2; x = $3; y = $4; z = $5; tx = $6; ty = $7; tz = $8
+      # Rows of R; the center is -(R^T t), i.e. minus the columns of R dotted with t.
+      r00 = 1 - 2*(y*y + z*z); r01 = 2*(x*y - w*z);     r02 = 2*(x*z + w*y)
+      r10 = 2*(x*y + w*z);     r11 = 1 - 2*(x*x + z*z); r12 = 2*(y*z - w*x)
+      r20 = 2*(x*z - w*y);     r21 = 2*(y*z + w*x);     r22 = 1 - 2*(x*x + y*y)
+      printf "%.17g %.17g %.17g\n", -(r00*tx + r10*ty + r20*tz),
+        -(r01*tx + r11*ty + r21*tz), -(r02*tx + r12*ty + r22*tz)
+      found = 1
+    }
+    !/^#/ { odd = !odd }
+    END { exit !found }' "$1/images.txt"
+}
+
 mkdir -p "$work_dir/sparse/0"
-if [[ -n "$ref_positions" ]]; then
+if [[ -n "${MAP_SCALE_DISTANCE:-}" ]]; then
+  [[ -z "$ref_positions" ]] || die "give REF_POSITIONS or MAP_SCALE_DISTANCE, not both"
+  read -r scale_a scale_b scale_distance extra <<< "$MAP_SCALE_DISTANCE"
+  [[ -n "$scale_distance" && -z "${extra:-}" ]] ||
+    die "MAP_SCALE_DISTANCE must be 'IMAGE_A IMAGE_B DISTANCE', got '$MAP_SCALE_DISTANCE'"
+  text_model="$work_dir/scale_text"
+  mkdir -p "$text_model"
+  "$colmap" model_converter --input_path "$best_model" --output_path "$text_model" \
+    --output_type TXT >> "$log" 2>&1 || die "colmap model_converter failed (log: $log)"
+  center_a=$(camera_center "$text_model" "$scale_a") ||
+    die "MAP_SCALE_DISTANCE: image $scale_a is not in the map"
+  center_b=$(camera_center "$text_model" "$scale_b") ||
+    die "MAP_SCALE_DISTANCE: image $scale_b is not in the map"
+  rm -rf "$text_model"
+  scale=$(awk -v a="$center_a" -v b="$center_b" -v d="$scale_distance" 'BEGIN {
+    split(a, p, " "); split(b, q, " ")
+    map_distance = sqrt((p[1]-q[1])^2 + (p[2]-q[2])^2 + (p[3]-q[3])^2)
+    if (d + 0 <= 0 || map_distance < 1e-12) exit 1
+    printf "%.17g", d / map_distance }') ||
+    die "MAP_SCALE_DISTANCE: DISTANCE must be positive and the two images apart"
+  printf '%s 0 0 0\n0 %s 0 0\n0 0 %s 0\n0 0 0 1\n' "$scale" "$scale" "$scale" \
+    > "$work_dir/scale_transform.txt"
+  step "scaling by $scale ($scale_a to $scale_b: $scale_distance)" model_transformer \
+    --input_path "$best_model" --output_path "$work_dir/sparse/0" \
+    --transform_path "$work_dir/scale_transform.txt"
+elif [[ -n "$ref_positions" ]]; then
   step "alignment to the reference positions" model_aligner \
     --input_path "$best_model" --output_path "$work_dir/sparse/0" \
     --ref_images_path "$ref_positions" --ref_is_gps 0 \

@@ -38,17 +38,8 @@ shift 4
 die() { echo "[calibrate_rig] ERROR: $*" >&2; exit 1; }
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
-if [[ -n "${COLMAP:-}" ]]; then
-  colmap="$COLMAP"
-elif [[ -x "$default_colmap" ]]; then
-  colmap="$default_colmap"
-elif command -v colmap > /dev/null; then
-  colmap="$(command -v colmap)"
-else
-  die "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
-fi
-[[ -x "$colmap" ]] || die "COLMAP=$colmap is not executable"
+# shellcheck source=find_colmap.sh
+source "$(dirname "${BASH_SOURCE[0]}")/find_colmap.sh"
 rig_calibrator="${RIG_CALIBRATOR:-$repo/build/rig_calibrator}"
 [[ -x "$rig_calibrator" ]] || die "no rig_calibrator at $rig_calibrator: build it (scripts/build.sh) or set RIG_CALIBRATOR"
 max_features="${RIG_MAX_FEATURES:-4096}"

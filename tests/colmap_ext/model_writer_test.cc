@@ -533,5 +533,36 @@ TEST(ModelWriter, RejectsMismatchedCalibration) {
   EXPECT_NE(error.find("has the name of a map image"), std::string::npos);
 }
 
+TEST(ModelWriter, MovesRefinedMapPoints) {
+  Scene scene = MakeScene();
+  const colmap::point3D_t point3D_id = *scene.map.Point3DIds().begin();
+  const Eigen::Vector3d moved =
+      scene.map.Point3D(point3D_id).XYZ() + Eigen::Vector3d(0.01, 0, 0);
+  scene.calibration.refined_points3D[point3D_id] = moved;
+  RigModel rig_model;
+  std::string error;
+  ASSERT_TRUE(BuildRigModel(scene.map, scene.dataset, scene.calibration,
+                            &rig_model, &error))
+      << error;
+  EXPECT_EQ(rig_model.model.Point3D(point3D_id).XYZ(), moved);
+
+  // A refined point that the map does not have is an inconsistency...
+  RigCalibration unknown_point = scene.calibration;
+  unknown_point.refined_points3D[1000000] = moved;
+  EXPECT_FALSE(BuildRigModel(scene.map, scene.dataset, unknown_point,
+                             &rig_model, &error));
+  EXPECT_NE(error.find("refined point 1000000 is not a map point"),
+            std::string::npos);
+  // ... except in a run from a correspondence file, which has no map points.
+  colmap::Reconstruction no_points;
+  for (const auto& [camera_id, camera] : scene.map.Cameras()) {
+    no_points.AddCamera(camera);
+  }
+  ASSERT_TRUE(BuildRigModel(no_points, scene.dataset, unknown_point, &rig_model,
+                            &error))
+      << error;
+  EXPECT_EQ(rig_model.model.NumPoints3D(), 0u);
+}
+
 }  // namespace
 }  // namespace rig_calibrator
