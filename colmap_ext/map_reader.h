@@ -11,9 +11,11 @@
 namespace rig_calibrator {
 
 // Reads the model in folder `path` (cameras, images, points3D as .bin, else
-// .txt). Fails with a message if the folder or a file is missing, a binary
-// file's record count does not fit its size, a text file does not parse, or
-// the model has no registered image or no 3D point.
+// .txt). Fails with a message if the folder or a file is missing or
+// unreadable, a binary file's records do not fit its size exactly, a camera
+// model is unknown to COLMAP 3.8 or has the wrong number of parameters, a text
+// file does not parse, images, cameras and points refer to each other
+// inconsistently, or the model has no registered image or no 3D point.
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              std::string* error);
 

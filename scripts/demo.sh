@@ -17,7 +17,7 @@
 #                    stereo_pair
 #   DEMO_SCENE       room (default), courtyard, street
 #   DEMO_SEED        0 (default)
-#   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 12)
+#   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 20)
 #   DEMO_SKIP_BUILD  1: use the built tree as it is
 #   RIG_CALIBRATOR_BUILD_DIR, COLMAP, MAP_*, RIG_*: see scripts/build.sh,
 #   scripts/build_map.sh and scripts/calibrate_rig.sh
@@ -29,7 +29,7 @@ preset="${DEMO_PRESET:-ring5}"
 scene="${DEMO_SCENE:-room}"
 seed="${DEMO_SEED:-0}"
 num_map_images="${DEMO_MAP_IMAGES:-60}"
-num_framesets="${DEMO_FRAMESETS:-12}"
+num_framesets="${DEMO_FRAMESETS:-20}"
 build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
 rig_calibrator="$build/rig_calibrator"
 

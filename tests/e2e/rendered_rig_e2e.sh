@@ -1,13 +1,24 @@
 #!/usr/bin/env bash
-# End-to-end test on rendered images: renders a small ring5 dataset in the
-# room, builds a metric map with the colmap CLI, calibrates the rig against
-# it and checks the calibration against the ground truth (every camera:
-# rotation < 0.5 degrees, center < 2 cm, focal length < 1 %).
+# End-to-end test on rendered images (ctest: rendered_rig_e2e, label e2e):
+#   1. renders a small ring5 dataset in the room, builds a metric map with the
+#      colmap CLI and calibrates the rig against it (scripts/demo.sh:
+#      build_map.sh, then calibrate_rig.sh with the database);
+#   2. accuracy: every camera within 0.5 degrees, 2 cm and 1 % focal length
+#      of the ground truth (rig_calibrator evaluate);
+#   3. outputs: `colmap model_analyzer` reads the model, and
+#      check_calibration_outputs checks that the model, rigs/frames,
+#      rig_config.json and camchain.yaml agree with calibration_summary.json
+#      (image poses = cam_from_rig * rig_from_world to 1e-9), and that it
+#      rejects a rig_config.json that is not the calibration's;
+#   4. re-run: calibrating from the correspondences.txt the run wrote
+#      reproduces the run (same cameras and images, intrinsics and poses
+#      within 1e-6 relative).
 #
 # Usage: tests/e2e/rendered_rig_e2e.sh BUILD_DIR [WORK_DIR]
-#   BUILD_DIR  holds the built rig_calibrator
+#   BUILD_DIR  the build tree: rig_calibrator and tests/check_calibration_outputs
 #   WORK_DIR   scratch folder (default: a fresh temporary folder, removed on
 #              success)
+# Environment: COLMAP (colmap 3.8 binary; default as scripts/build_map.sh).
 set -euo pipefail
 
 [[ $# -ge 1 ]] || { echo "usage: $0 BUILD_DIR [WORK_DIR]" >&2; exit 2; }
@@ -16,15 +27,32 @@ build="$(cd "$1" && pwd)"
 work="${2:-$(mktemp -d)}"
 fail() { echo "[e2e] FAILED: $*" >&2; echo "[e2e] outputs kept in $work" >&2; exit 1; }
 
+rig_calibrator="$build/rig_calibrator"
+checker="$build/tests/check_calibration_outputs"
+[[ -x "$rig_calibrator" ]] || fail "no $rig_calibrator: build the project first"
+[[ -x "$checker" ]] || fail "no $checker: build the target check_calibration_outputs"
+default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
+if [[ -n "${COLMAP:-}" ]]; then
+  colmap="$COLMAP"
+elif [[ -x "$default_colmap" ]]; then
+  colmap="$default_colmap"
+else
+  colmap="$(command -v colmap)" || fail "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
+fi
+
+start=$SECONDS
 DEMO_SKIP_BUILD=1 RIG_CALIBRATOR_BUILD_DIR="$build" DEMO_PRESET=ring5 \
   DEMO_SCENE=room DEMO_MAP_IMAGES=40 DEMO_FRAMESETS=8 MAP_OVERLAP=4 \
   RIG_MAX_FEATURES=2048 bash "$repo/scripts/demo.sh" "$work/demo" ||
   fail "the demo pipeline"
+demo_seconds=$((SECONDS - start))
+calibration="$work/demo/rig/calibration"
+truth="$work/demo/dataset/ground_truth"
 
+# 2. Accuracy against the ground truth.
 errors="$work/errors.json"
-"$build/rig_calibrator" evaluate \
-  --reference_path "$work/demo/dataset/ground_truth/rig_config.json" \
-  --calibration_path "$work/demo/rig/calibration" --output_path "$errors" \
+"$rig_calibrator" evaluate --reference_path "$truth/rig_config.json" \
+  --calibration_path "$calibration" --output_path "$errors" \
   > /dev/null || fail "evaluate"
 
 # The largest value of a per-camera field of the evaluation's JSON.
@@ -42,5 +70,40 @@ echo "[e2e] max errors: rotation $rotation deg, center $center m, focal $focal %
 awk -v r="$rotation" -v c="$center" -v f="$focal" \
   'BEGIN { exit !(r < 0.5 && c < 0.02 && f < 1.0) }' ||
   fail "errors above the bounds (0.5 deg, 0.02 m, 1 %)"
+
+# 3. The outputs, read by COLMAP and by the project's readers.
+"$colmap" model_analyzer --path "$calibration" > "$work/model_analyzer.log" 2>&1 ||
+  fail "colmap model_analyzer cannot read $calibration (log: $work/model_analyzer.log)"
+registered=$(sed -n 's/.*Registered images: *\([0-9]*\).*/\1/p' "$work/model_analyzer.log" | head -n 1)
+map_registered=$("$colmap" model_analyzer --path "$work/demo/map/sparse/0" 2>&1 |
+  sed -n 's/.*Registered images: *\([0-9]*\).*/\1/p' | head -n 1)
+echo "[e2e] colmap model_analyzer: ${registered:-?} registered images (map: ${map_registered:-?})"
+[[ -n "$registered" && -n "$map_registered" && "$registered" -gt "$map_registered" ]] ||
+  fail "colmap model_analyzer finds no rig image in the calibrated model"
+"$checker" "$calibration" || fail "the outputs of $calibration disagree"
+# The checker itself must see a wrong file: the true rig's rig_config.json in
+# place of the calibrated one (they differ by the calibration error).
+tampered="$work/tampered"
+cp -r "$calibration" "$tampered"
+cp "$truth/rig_config.json" "$tampered/rig_config.json"
+if "$checker" "$tampered" > "$work/tampered.log" 2>&1 ||
+    ! grep -q "rig_config.json = summary: .*FAILED" "$work/tampered.log"; then
+  fail "check_calibration_outputs misses a rig_config.json that is not the calibration's (log: $work/tampered.log)"
+fi
+echo "[e2e] check_calibration_outputs rejects the true rig's rig_config.json in place of the calibration's"
+
+# 4. A re-run from the correspondence file the run wrote, with the same map
+# and camera models, reproduces the run without the database.
+camera_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
+rerun="$work/rerun"
+start=$SECONDS
+"$rig_calibrator" --correspondences_path "$calibration/correspondences.txt" \
+  --input_path "$work/demo/map/sparse/0" --output_path "$rerun" \
+  --RigCalibrator.camera_model "$camera_models" > "$work/rerun.log" 2>&1 ||
+  fail "the re-run from $calibration/correspondences.txt (log: $work/rerun.log)"
+echo "[e2e] re-run from correspondences.txt: $((SECONDS - start)) s"
+"$checker" "$rerun" "$calibration" ||
+  fail "the re-run from correspondences.txt does not reproduce the run"
+
 [[ $# -ge 2 ]] || rm -rf "$work"
-echo "[e2e] passed"
+echo "[e2e] passed (demo pipeline $demo_seconds s)"
