@@ -21,4 +21,8 @@ int RunSynthetic(int argc, char** argv);
 // The paper's short-sequence robustness experiment on synthetic rigs.
 int RunBenchmark(int argc, char** argv);
 
+// Time and peak memory of the calibration core and of the localization
+// (runtime_benchmark_command.cc).
+int RunRuntimeBenchmark(int argc, char** argv);
+
 }  // namespace rig_calibrator

@@ -1,11 +1,12 @@
 // rig_calibrator: calibrates a multi-camera rig against a COLMAP map.
 //
-//   rig_calibrator [calibrate] --database_path ... --image_path ... \
+//   rig_calibrator [calibrate] --database_path ... --image_path ...
 //                  --input_path ... --output_path ...
 //   rig_calibrator evaluate ...
-//   rig_calibrator synthetic | render | benchmark ...
+//   rig_calibrator synthetic | render | benchmark | benchmark_runtime ...
 //
 // The first form is the default command; `rig_calibrator help` lists all.
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <iostream>
@@ -40,6 +41,9 @@ Commands() {
           {"benchmark",
            {&rig_calibrator::RunBenchmark,
             "robustness of the methods on short sequences (paper 5.3)"}},
+          {"benchmark_runtime",
+           {&rig_calibrator::RunRuntimeBenchmark,
+            "time and memory of the calibration and the localization"}},
       };
   return commands;
 }
@@ -54,7 +58,8 @@ int ShowHelp() {
                "  rig_calibrator <command> --help\n\n"
                "Commands:\n";
   for (const auto& [name, command] : Commands()) {
-    std::cout << "  " << name << std::string(12 - name.size(), ' ')
+    std::cout << "  " << name
+              << std::string(std::max<int>(1, 19 - name.size()), ' ')
               << command.second << "\n";
   }
   return EXIT_SUCCESS;

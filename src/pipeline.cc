@@ -1,6 +1,7 @@
 #include "src/pipeline.h"
 
 #include <colmap/util/timer.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <iomanip>
@@ -37,20 +38,33 @@ std::string CameraList(const RigDataset& dataset,
   return list;
 }
 
-// Times a stage and prints its heading; the destructor records the time.
+// User + system CPU time of the process so far (all threads).
+double ProcessCpuSeconds() {
+  rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
+         1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+// Times a stage and prints its heading; the destructor records the wall and
+// CPU times.
 class Stage {
  public:
   Stage(const std::string& name, bool print, PipelineReport* report)
-      : name_(name), report_(report) {
+      : name_(name), report_(report), cpu_start_(ProcessCpuSeconds()) {
     if (print) std::cout << "== " << name << std::endl;
     timer_.Start();
   }
-  ~Stage() { report_->timings.push_back({name_, timer_.ElapsedSeconds()}); }
+  ~Stage() {
+    report_->timings.push_back(
+        {name_, timer_.ElapsedSeconds(), ProcessCpuSeconds() - cpu_start_});
+  }
 
  private:
   std::string name_;
   PipelineReport* report_;
   colmap::Timer timer_;
+  double cpu_start_;
 };
 
 void AddDiagnostic(PipelineReport* report, Diagnostic::Level level,
@@ -610,6 +624,9 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
     return false;
   }
 
+  report->initial_cameras = calibration->cameras;
+  report->initial_cam_from_rig = calibration->cam_from_rig;
+  report->initial_camera_calibrated = calibration->camera_calibrated;
   {
     Stage stage("Final bundle adjustment", options.print_progress, report);
     SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);

@@ -71,7 +71,10 @@ struct PipelineOptions {
 
 struct StageTiming {
   std::string stage;
-  double seconds = 0;
+  double seconds = 0;  // wall time
+  // CPU time of the whole process (all threads, user + system) during the
+  // stage: unlike wall time, hardly affected by other work on the machine.
+  double cpu_seconds = 0;
 };
 
 struct PipelineReport {
@@ -85,6 +88,12 @@ struct PipelineReport {
   int num_framesets_posed = 0;
   double final_rms_px = 0;
   double total_seconds = 0;
+  // The rig as it entered the final bundle adjustment (paper Fig. 6, the
+  // "initial estimates"): from the rig initialization (rd, rd_ra, known*) or
+  // the camera upgrade (1dr). Empty when the pipeline stopped before.
+  std::vector<colmap::Camera> initial_cameras;
+  std::vector<Rigid3d> initial_cam_from_rig;
+  std::vector<bool> initial_camera_calibrated;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

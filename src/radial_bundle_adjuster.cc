@@ -24,42 +24,6 @@ constexpr int kMinInliersPerImage = 5;
 // max_radial_error_px is taken as mis-localized and dropped whole.
 constexpr double kMinInlierShare = 0.5;
 
-// Radial residual (RadialResidual) of one correspondence of camera i in
-// frameset j: the camera-frame point is P_i Q_j X, the observation is taken
-// relative to the principal point c_i. Parameters: cam_from_rig and
-// rig_from_world as (angle-axis, translation), c_i (2).
-class RadialRigCost {
- public:
-  RadialRigCost(const Eigen::Vector2d& point2D, const Eigen::Vector3d& point3D)
-      : point2D_(point2D), point3D_(point3D) {}
-
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
-                                     const Eigen::Vector3d& point3D) {
-    return new ceres::AutoDiffCostFunction<RadialRigCost, 2, 6, 6, 2>(
-        new RadialRigCost(point2D, point3D));
-  }
-
-  template <typename T>
-  bool operator()(const T* cam_from_rig, const T* rig_from_world,
-                  const T* principal_point, T* residuals) const {
-    const T point3D[3] = {T(point3D_(0)), T(point3D_(1)), T(point3D_(2))};
-    T point_in_rig[3];
-    ceres::AngleAxisRotatePoint(rig_from_world, point3D, point_in_rig);
-    for (int r = 0; r < 3; ++r) point_in_rig[r] += rig_from_world[3 + r];
-    T point_in_cam[3];
-    ceres::AngleAxisRotatePoint(cam_from_rig, point_in_rig, point_in_cam);
-    for (int r = 0; r < 3; ++r) point_in_cam[r] += cam_from_rig[3 + r];
-    const T centered[2] = {T(point2D_(0)) - principal_point[0],
-                           T(point2D_(1)) - principal_point[1]};
-    RadialResidual(centered, point_in_cam, residuals);
-    return true;
-  }
-
- private:
-  const Eigen::Vector2d point2D_;
-  const Eigen::Vector3d point3D_;
-};
-
 // One correspondence in the adjustment.
 struct Observation {
   int image;  // dataset image index
@@ -79,11 +43,13 @@ struct Parameters {
 // |pi_r(...) - (x - c)|: the radial reprojection error of an observation.
 double RadialError(const Observation& observation,
                    const Parameters& parameters) {
-  double residual[2];
-  RadialRigCost(observation.point2D, observation.point3D)(
+  const double* blocks[] = {
       parameters.cam_from_rig[observation.camera].data(),
       parameters.rig_from_world[observation.frameset].data(),
-      parameters.principal_points[observation.camera].data(), residual);
+      parameters.principal_points[observation.camera].data()};
+  double residual[2];
+  RadialRigCostFunction(observation.point2D, observation.point3D)
+      .Evaluate(blocks, residual, nullptr);
   return std::hypot(residual[0], residual[1]);
 }
 
@@ -151,8 +117,8 @@ ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
   std::vector<char> rig_added(num_framesets, 0);
   for (const Observation& observation : observations) {
     problem.AddResidualBlock(
-        RadialRigCost::Create(observation.point2D, observation.point3D), loss,
-        parameters->cam_from_rig[observation.camera].data(),
+        new RadialRigCostFunction(observation.point2D, observation.point3D),
+        loss, parameters->cam_from_rig[observation.camera].data(),
         parameters->rig_from_world[observation.frameset].data(),
         parameters->principal_points[observation.camera].data());
     cam_added[observation.camera] = 1;

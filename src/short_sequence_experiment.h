@@ -25,6 +25,8 @@ struct ShortSequenceOptions {
                                             CalibrationMethod::kRdRa,
                                             CalibrationMethod::kRadial1D};
   unsigned int seed = 0;
+  // Sequences are calibrated in parallel, each on one thread (-1: all
+  // cores); results do not depend on it.
   int num_threads = -1;
 };
 
@@ -37,6 +39,15 @@ struct ShortSequenceResult {
   // complete).
   std::vector<double> max_rotation_deg;
   std::vector<double> max_center_error;
+  // Per camera of every sequence (sequence-major), the rotation (deg) and
+  // center errors of the rig as it entered the final bundle adjustment
+  // (paper Fig. 6) and of the final rig; infinity where the camera was not
+  // calibrated at that point or the sequence failed before it.
+  std::vector<double> initial_rotation_deg, initial_center_error;
+  std::vector<double> final_rotation_deg, final_center_error;
+  // Sequences where 1dr fell back to rd_ra (parallel principal axes).
+  int num_fallbacks = 0;
+  // Sum of the calibrations' own run times (one thread each).
   double seconds = 0;
 
   double PercentComplete() const;
@@ -47,8 +58,13 @@ struct ShortSequenceResult {
 std::vector<ShortSequenceResult> RunShortSequenceExperiment(
     const ShortSequenceOptions& options);
 
-// A Markdown table: method, sequences, % complete, % good, median errors.
+// A Markdown table: method, sequences, % complete, % good, median errors
+// (final and initial), seconds per sequence.
 std::string FormatShortSequenceResults(
     const std::vector<ShortSequenceResult>& results);
+
+// The median of the finite values and infinity for failures, as they rank
+// (NaN for no values).
+double MedianWithFailures(std::vector<double> values);
 
 }  // namespace rig_calibrator

@@ -23,6 +23,8 @@ constexpr double kMinOutlierOffsetPx = 20.0;
 constexpr int kTrackWindowFramesets = 3;
 // Random pixels drawn before giving up on one correspondence.
 constexpr int kMaxSampleAttempts = 100;
+// Most cameras of a ring (ring_num_cameras): 10 degrees apart.
+constexpr int kMaxRingCameras = 36;
 
 // One camera of a preset, placed in the body frame (x forward, y left, z up).
 struct CameraSpec {
@@ -85,7 +87,10 @@ void PlaceOnRing(double radius, std::vector<CameraSpec>* cameras) {
   }
 }
 
-PresetDefinition Ring5() {
+// ring5, or its layout with num_cameras cameras (ring_num_cameras): camera i
+// takes the parameters of ring5's camera i mod 5, its focal lengths scaled by
+// 1 + 0.03 * (i / 5) so that no two cameras are alike.
+PresetDefinition Ring(int num_cameras) {
   PresetDefinition preset;
   // fx, fy, cx, cy, k1, k2, p1, p2; principal points off the center
   // (320, 240) by up to 20 px in varied directions.
@@ -98,15 +103,17 @@ PresetDefinition Ring5() {
   const double pitch_deg[] = {2, -3, 1, -2, 3};
   const double roll_deg[] = {0, 1, -1, 0.5, -0.5};
   const double height_m[] = {0, 0.01, -0.005, 0.008, -0.01};
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < num_cameras; ++i) {
     CameraSpec spec;
     spec.model_name = "OPENCV";
     spec.width = 640;
     spec.height = 480;
-    spec.params = params[i];
-    spec.pitch_deg = pitch_deg[i];
-    spec.roll_deg = roll_deg[i];
-    spec.position.z() = height_m[i];
+    spec.params = params[i % 5];
+    spec.params[0] *= 1 + 0.03 * (i / 5);
+    spec.params[1] *= 1 + 0.03 * (i / 5);
+    spec.pitch_deg = pitch_deg[i % 5];
+    spec.roll_deg = roll_deg[i % 5];
+    spec.position.z() = height_m[i % 5];
     preset.cameras.push_back(spec);
   }
   PlaceOnRing(0.15, &preset.cameras);
@@ -240,7 +247,7 @@ PresetDefinition StereoPair() {
 PresetDefinition MakePresetDefinition(RigPreset preset) {
   switch (preset) {
     case RigPreset::kRing5:
-      return Ring5();
+      return Ring(5);
     case RigPreset::kFisheyeHelmet5:
       return FisheyeHelmet5();
     case RigPreset::kCarSurround4:
@@ -248,7 +255,14 @@ PresetDefinition MakePresetDefinition(RigPreset preset) {
     case RigPreset::kStereoPair:
       return StereoPair();
   }
-  return Ring5();
+  return Ring(5);
+}
+
+PresetDefinition MakePresetDefinition(const SyntheticRigOptions& options) {
+  if (options.preset == RigPreset::kRing5 && options.ring_num_cameras > 0) {
+    return Ring(options.ring_num_cameras);
+  }
+  return MakePresetDefinition(options.preset);
 }
 
 colmap::Camera MakeCamera(const std::string& model_name, int width, int height,
@@ -338,6 +352,14 @@ struct ImageContext {
   Rigid3d cam_from_world;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // in the world
   Eigen::Matrix3d world_from_cam_rotation = Eigen::Matrix3d::Identity();
+  // Pixel window holding the image's correspondences (feature_window).
+  Eigen::Vector2d window_min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d window_max = Eigen::Vector2d::Zero();
+
+  bool InWindow(const Eigen::Vector2d& xy) const {
+    return xy.x() >= window_min.x() && xy.y() >= window_min.y() &&
+           xy.x() <= window_max.x() && xy.y() <= window_max.y();
+  }
 };
 
 // The generator's state: the map points created so far, with the frameset
@@ -374,7 +396,8 @@ class PointGenerator {
             options_.min_depth, options_.max_depth)(*rng_);
       }
       const Eigen::Vector3d point = image.center + distance * ray_in_world;
-      if (!ProjectIntoImage(*image.camera, image.cam_from_world * point, xy)) {
+      if (!ProjectIntoImage(*image.camera, image.cam_from_world * point, xy) ||
+          !image.InWindow(*xy)) {
         continue;
       }
       *point3D_id = AddPoint(point, frameset);
@@ -399,7 +422,8 @@ class PointGenerator {
       const double distance = point_in_camera.norm();
       Eigen::Vector2d xy;
       if (distance < options_.min_depth || distance > options_.max_depth ||
-          !ProjectIntoImage(*image.camera, point_in_camera, &xy)) {
+          !ProjectIntoImage(*image.camera, point_in_camera, &xy) ||
+          !image.InWindow(xy)) {
         continue;
       }
       point3D_ids->push_back(id);
@@ -475,10 +499,10 @@ class PointGenerator {
   // The world direction of the ray through a uniformly random pixel.
   bool RandomRay(const ImageContext& image, Eigen::Vector3d* ray_in_world) {
     const colmap::Camera& camera = *image.camera;
-    const double x =
-        std::uniform_real_distribution<double>(0, camera.Width())(*rng_);
-    const double y =
-        std::uniform_real_distribution<double>(0, camera.Height())(*rng_);
+    const double x = std::uniform_real_distribution<double>(
+        image.window_min.x(), image.window_max.x())(*rng_);
+    const double y = std::uniform_real_distribution<double>(
+        image.window_min.y(), image.window_max.y())(*rng_);
     double u = 0, v = 0;
     colmap::CameraModelImageToWorld(camera.ModelId(), camera.Params(), x, y, &u,
                                     &v);
@@ -551,6 +575,21 @@ std::string FramesetName(int frameset) {
   return name;
 }
 
+// The true cameras and extrinsics of a rig definition (no rig poses).
+RigGroundTruth TruthOfDefinition(const PresetDefinition& definition) {
+  RigGroundTruth truth;
+  const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);
+  for (size_t i = 0; i < definition.cameras.size(); ++i) {
+    const CameraSpec& spec = definition.cameras[i];
+    truth.cameras.push_back(MakeCamera(spec.model_name, spec.width, spec.height,
+                                       spec.params, i + 1));
+    truth.cam_from_rig.push_back(
+        i == 0 ? Rigid3d() : BodyFromCamera(spec).Inverse() * body_from_rig);
+    truth.camera_names.push_back("cam" + std::to_string(i));
+  }
+  return truth;
+}
+
 }  // namespace
 
 bool RigPresetFromName(const std::string& name, RigPreset* preset) {
@@ -583,18 +622,7 @@ std::vector<RigPreset> AllRigPresets() {
 }
 
 RigGroundTruth MakeRigPreset(RigPreset preset) {
-  const PresetDefinition definition = MakePresetDefinition(preset);
-  RigGroundTruth truth;
-  const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);
-  for (size_t i = 0; i < definition.cameras.size(); ++i) {
-    const CameraSpec& spec = definition.cameras[i];
-    truth.cameras.push_back(MakeCamera(spec.model_name, spec.width, spec.height,
-                                       spec.params, i + 1));
-    truth.cam_from_rig.push_back(
-        i == 0 ? Rigid3d() : BodyFromCamera(spec).Inverse() * body_from_rig);
-    truth.camera_names.push_back("cam" + std::to_string(i));
-  }
-  return truth;
+  return TruthOfDefinition(MakePresetDefinition(preset));
 }
 
 bool SyntheticRigOptions::Check(std::string* error) const {
@@ -617,6 +645,14 @@ bool SyntheticRigOptions::Check(std::string* error) const {
     message << "near_planar_ratio must be in [0, 1], got " << near_planar_ratio;
   } else if (!(track_ratio >= 0 && track_ratio <= 1)) {
     message << "track_ratio must be in [0, 1], got " << track_ratio;
+  } else if (ring_num_cameras != 0 &&
+             (preset != RigPreset::kRing5 || ring_num_cameras < 2 ||
+              ring_num_cameras > kMaxRingCameras)) {
+    message << "ring_num_cameras must be 0, or 2.." << kMaxRingCameras
+            << " with the ring5 preset, got " << ring_num_cameras << " with "
+            << RigPresetName(preset);
+  } else if (!(feature_window > 0 && feature_window <= 1)) {
+    message << "feature_window must be in (0, 1], got " << feature_window;
   } else {
     return true;
   }
@@ -632,8 +668,8 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
     return rig;
   }
   std::mt19937 rng(options.seed);
-  const PresetDefinition definition = MakePresetDefinition(options.preset);
-  rig.truth = MakeRigPreset(options.preset);
+  const PresetDefinition definition = MakePresetDefinition(options);
+  rig.truth = TruthOfDefinition(definition);
   const int num_cameras = rig.truth.cameras.size();
 
   const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);
@@ -680,6 +716,18 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
       const Rigid3d world_from_cam = context.cam_from_world.Inverse();
       context.center = world_from_cam.translation;
       context.world_from_cam_rotation = world_from_cam.RotationMatrix();
+      const Eigen::Vector2d size(context.camera->Width(),
+                                 context.camera->Height());
+      context.window_max = size;
+      if (options.feature_window < 1) {
+        // Drawn only for partial windows, so that whole-image datasets stay
+        // those of earlier versions for the same seed.
+        const Eigen::Vector2d window = options.feature_window * size;
+        std::uniform_real_distribution<double> unit(0, 1);
+        context.window_min.x() = unit(rng) * (size.x() - window.x());
+        context.window_min.y() = unit(rng) * (size.y() - window.y());
+        context.window_max = context.window_min + window;
+      }
 
       std::vector<int64_t> ids;
       std::vector<Eigen::Vector2d> xys;

@@ -70,6 +70,18 @@ struct SyntheticRigOptions {
   // by images of the previous framesets (feature tracks, shared point3D_id),
   // as far as such points are visible; the rest are new map points.
   double track_ratio = 0.5;
+  // Side of the window, as a share of the image width and height, that holds
+  // an image's correspondences; the window is placed at random per image
+  // (1: the whole image). Small windows model images whose features cluster
+  // on one textured region, leaving the image's own intrinsics poorly
+  // determined while all images of a camera together still cover it.
+  double feature_window = 1.0;
+  // ring5 only: the number of cameras on the ring (0: the preset's 5; at
+  // most 36), evenly spaced on its 0.15 m circle, looking outwards. Camera i
+  // has the model, size, distortion, pitch, roll and height of ring5's camera
+  // i mod 5 and its focal lengths scaled by 1 + 0.03 * floor(i / 5). E.g. 10
+  // for a 10-camera rig (runtime benchmark).
+  int ring_num_cameras = 0;
   unsigned int seed = 0;
 
   // False (with a message) for values outside their ranges.

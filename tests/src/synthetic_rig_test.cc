@@ -498,5 +498,94 @@ TEST(SyntheticRig, SetKnownIntrinsicsCopiesTheTruth) {
   }
 }
 
+// Each image's correspondences lie in one window of the requested size (up
+// to the pixel noise), placed differently in different images.
+TEST(SyntheticRig, FeatureWindowClustersEachImage) {
+  SyntheticRigOptions options = SmallOptions(RigPreset::kRing5);
+  options.feature_window = 0.3;
+  options.noise_px = 0.5;
+  const SyntheticRig rig = GenerateSyntheticRig(options);
+  ASSERT_FALSE(rig.dataset.images.empty());
+  std::set<int> window_columns;
+  for (const RigImage& image : rig.dataset.images) {
+    ASSERT_GE(image.correspondences.size(), 50u) << image.name;
+    Eigen::Vector2d low = image.correspondences[0].point2D, high = low;
+    for (const Correspondence& correspondence : image.correspondences) {
+      low = low.cwiseMin(correspondence.point2D);
+      high = high.cwiseMax(correspondence.point2D);
+    }
+    // 0.3 * 640 = 192 px and 0.3 * 480 = 144 px, plus 4 sigma of noise.
+    EXPECT_LE(high.x() - low.x(), 192 + 4) << image.name;
+    EXPECT_LE(high.y() - low.y(), 144 + 4) << image.name;
+    EXPECT_GE(high.x() - low.x(), 100) << image.name;
+    window_columns.insert(static_cast<int>(low.x() / 100));
+  }
+  EXPECT_GE(window_columns.size(), 3u);
+  options.feature_window = 0;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("feature_window"), std::string::npos);
+}
+
+// ring_num_cameras: 5 reproduces ring5 exactly; 10 spaces the cameras 36
+// degrees apart on the same 0.15 m ring with distinct focal lengths, and every
+// image still gets its correspondences; other presets and sizes are refused.
+TEST(SyntheticRig, RingWithNCameras) {
+  SyntheticRigOptions options = SmallOptions(RigPreset::kRing5);
+  const SyntheticRig ring5 = GenerateSyntheticRig(options);
+  options.ring_num_cameras = 5;
+  const SyntheticRig same = GenerateSyntheticRig(options);
+  ASSERT_EQ(same.dataset.images.size(), ring5.dataset.images.size());
+  for (size_t i = 0; i < ring5.dataset.images.size(); ++i) {
+    ASSERT_EQ(same.dataset.images[i].correspondences.size(),
+              ring5.dataset.images[i].correspondences.size());
+    for (size_t k = 0; k < ring5.dataset.images[i].correspondences.size();
+         ++k) {
+      EXPECT_EQ(same.dataset.images[i].correspondences[k].point2D,
+                ring5.dataset.images[i].correspondences[k].point2D);
+    }
+  }
+
+  options.ring_num_cameras = 10;
+  const SyntheticRig ring10 = GenerateSyntheticRig(options);
+  ASSERT_EQ(ring10.truth.cameras.size(), 10u);
+  ASSERT_EQ(ring10.dataset.cameras.size(), 10u);
+  std::set<double> focal_lengths;
+  for (int i = 0; i < 10; ++i) {
+    const colmap::Camera& camera = ring10.truth.cameras[i];
+    EXPECT_EQ(camera.ModelName(), "OPENCV");
+    EXPECT_EQ(ring10.truth.camera_names[i], "cam" + std::to_string(i));
+    EXPECT_NEAR(camera.FocalLengthX(),
+                ring5.truth.cameras[i % 5].FocalLengthX() * (i < 5 ? 1 : 1.03),
+                1e-9);
+    focal_lengths.insert(camera.FocalLengthX());
+    // Neighbours 36 degrees apart (up to the few degrees of pitch and
+    // roll), centers 2 r sin(pi i / 10) from the reference camera's.
+    const double angle =
+        RotationDifferenceDeg(ring10.truth.cam_from_rig[0].rotation,
+                              ring10.truth.cam_from_rig[i].rotation);
+    EXPECT_NEAR(angle, std::min(36.0 * i, 360 - 36.0 * i), 6.0) << i;
+    EXPECT_NEAR(ring10.truth.cam_from_rig[i].Center().norm(),
+                2 * 0.15 * std::sin(M_PI * i / 10), 0.02)
+        << i;
+  }
+  EXPECT_EQ(focal_lengths.size(), 10u);
+  std::vector<int> images_per_camera(10, 0);
+  for (const RigImage& image : ring10.dataset.images) {
+    ++images_per_camera[image.camera_index];
+    EXPECT_EQ(image.correspondences.size(), 100u) << image.name;
+  }
+  for (int i = 0; i < 10; ++i) EXPECT_GE(images_per_camera[i], 8) << i;
+
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options.ring_num_cameras = 1;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("ring_num_cameras"), std::string::npos);
+  options.ring_num_cameras = 10;
+  options.preset = RigPreset::kFisheyeHelmet5;
+  EXPECT_FALSE(options.Check(&error));
+}
+
 }  // namespace
 }  // namespace rig_calibrator

@@ -1,0 +1,114 @@
+#!/usr/bin/env bash
+# Runtime benchmark: time and peak memory of the calibration core on
+# synthetic rigs (10-500 framesets x 5 and 10 cameras, ~300 correspondences
+# per image) and of the localization against a 300-image map
+# (`rig_calibrator benchmark_runtime`), and optionally the end-to-end time of
+# the rendered demo (scripts/demo.sh) split into COLMAP's steps and ours.
+#
+# Usage: scripts/benchmark_runtime.sh RESULTS_DIR [benchmark_runtime options...]
+#   RESULTS_DIR  created if needed; gets runtime.md, runtime_calibration.csv,
+#                runtime_calibration.svg, runtime_localization.csv,
+#                runtime_log.txt and, with the demo, runtime_demo.md and
+#                runtime_demo_log.txt (other files are left alone)
+#   options      passed to `rig_calibrator benchmark_runtime`, e.g.
+#                --framesets 10,50 --cameras 5 --localization 0
+# Environment:
+#   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator (default: build/)
+#   RUNTIME_DEMO=1            also time the rendered demo (about 3-4 minutes on
+#                             2 idle cores; DEMO_* variables apply)
+#   BENCHMARK_QUICK=1         without options: a smoke run (10 and 50
+#                             framesets, fewer localized images)
+set -euo pipefail
+
+usage() {
+  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'
+}
+
+if [[ $# -lt 1 || "$1" == "-h" || "$1" == "--help" ]]; then
+  usage >&2
+  exit 2
+fi
+results="$1"
+shift
+
+die() { echo "[benchmark_runtime] ERROR: $*" >&2; exit 1; }
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+rig_calibrator="$build/rig_calibrator"
+[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+mkdir -p "$results" || die "cannot create $results"
+results="$(cd "$results" && pwd)"
+
+options=("$@")
+if [[ "${BENCHMARK_QUICK:-0}" == 1 && $# -eq 0 ]]; then
+  options=(--framesets 10,50 --rig_features 2000 --rig_images 10
+           --retrieval_images 2)
+fi
+
+echo "[benchmark_runtime] $(uptime)"
+status=0
+"$rig_calibrator" benchmark_runtime --output_path "$results" "${options[@]}" 2>&1 |
+  tee "$results/runtime_log.txt" || status=${PIPESTATUS[0]}
+[[ "$status" -eq 0 ]] || die "rig_calibrator benchmark_runtime failed with status $status (log: $results/runtime_log.txt)"
+
+if [[ "${RUNTIME_DEMO:-0}" != 1 ]]; then
+  echo "[benchmark_runtime] rendered demo skipped (RUNTIME_DEMO=1 times it)"
+  exit 0
+fi
+
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+demo_log="$results/runtime_demo_log.txt"
+echo "[benchmark_runtime] rendered demo into $work (log: $demo_log) ..."
+load_before="$(cut -d' ' -f1-3 /proc/loadavg)"
+TIMEFORMAT='%R %U %S'
+if ! { time DEMO_SKIP_BUILD=1 RIG_CALIBRATOR_BUILD_DIR="$build" \
+    bash "$repo/scripts/demo.sh" "$work/demo" > "$demo_log" 2>&1; } \
+    2> "$work/time.txt"; then
+  tail -n 20 "$demo_log" >&2
+  die "scripts/demo.sh failed (log: $demo_log)"
+fi
+read -r demo_wall demo_user demo_sys < "$work/time.txt"
+load_after="$(cut -d' ' -f1-3 /proc/loadavg)"
+
+# "[build_map] NAME: N s" and "[calibrate_rig] NAME: N s" lines -> rows.
+step_rows() {
+  local tag="$1" who="$2"
+  sed -n "s/^\[$tag\] \(.*\): \([0-9][0-9]*\) s$/| $who | \1 | \2 |/p" "$demo_log"
+}
+# rig_calibrator's own lines: localization and the calibration core.
+localization_s=$(sed -n 's/^  .* 2D-3D correspondences for .* in \([0-9.]*\) s$/\1/p' "$demo_log" | tail -n 1)
+calibration_s=$(sed -n 's/^== Result (.*, \([0-9.]*\) s)$/\1/p' "$demo_log" | tail -n 1)
+render_s=$(sed -n 's/^  render ([^)]*) *\([0-9][0-9]*\) s$/\1/p' "$demo_log")
+total_s=$(sed -n 's/^  total *\([0-9][0-9]*\) s$/\1/p' "$demo_log")
+summary="$work/demo/rig/calibration/calibration_summary.json"
+
+{
+  echo "# Rendered demo: end-to-end time"
+  echo
+  echo "\`DEMO_SKIP_BUILD=1 scripts/demo.sh\` (preset ${DEMO_PRESET:-ring5}, scene ${DEMO_SCENE:-room}," \
+       "${DEMO_MAP_IMAGES:-60} map images, ${DEMO_FRAMESETS:-12} framesets)," \
+       "load average $load_before before and $load_after after."
+  echo "Whole demo: $demo_wall s wall, $demo_user s user + $demo_sys s system CPU."
+  echo
+  echo "| who | step | wall s |"
+  echo "|---|---|---|"
+  [[ -n "$render_s" ]] && echo "| ours | render the images (demo input) | $render_s |"
+  step_rows build_map COLMAP
+  sed -n 's/^\[calibrate_rig\] feature extraction: \([0-9][0-9]*\) s$/| COLMAP | feature extraction of the rig images | \1 |/p' "$demo_log"
+  sed -n 's/^\[calibrate_rig\] rig_calibrator: \([0-9][0-9]*\) s$/| ours | rig_calibrator (read, localize, calibrate, write) | \1 |/p' "$demo_log"
+  [[ -n "$localization_s" ]] && echo "| ours | of which localization against the map | $localization_s |"
+  [[ -n "$calibration_s" ]] && echo "| ours | of which calibration core | $calibration_s |"
+  [[ -n "$total_s" ]] && echo "| all | total (with evaluation) | $total_s |"
+  if [[ -f "$summary" ]]; then
+    echo
+    echo "Calibration stages (wall s, from calibration_summary.json):"
+    echo
+    echo '```'
+    sed -n '/"timings_s"/,/}/p' "$summary"
+    echo '```'
+  fi
+} > "$results/runtime_demo.md"
+cat "$results/runtime_demo.md"
+echo "[benchmark_runtime] wrote $results/runtime_demo.md"
