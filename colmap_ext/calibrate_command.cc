@@ -61,6 +61,9 @@ struct CalibrateOptions {
   std::string localization_mode = "direct";
   std::string vocab_tree_path;
   int num_retrieved_images = 10;
+  int num_checks = PointDescriptorIndex::Options().num_checks;
+  int max_descriptors_per_point =
+      MapLocalizerOptions().max_descriptors_per_point;
   bool use_database_matches = true;
   colmap::SiftMatchingOptions sift_matching;
 };
@@ -135,6 +138,14 @@ po::options_description Describe(CalibrateOptions* o) {
       po::value(&o->num_retrieved_images)
           ->default_value(o->num_retrieved_images),
       "map images matched per rig image in retrieval mode")(
+      "Localization.num_checks",
+      po::value(&o->num_checks)->default_value(o->num_checks),
+      "direct mode: FLANN leaf checks per rig feature (fewer: faster, "
+      "fewer matches; COLMAP's matcher uses 128, twice the time)")(
+      "Localization.max_descriptors_per_point",
+      po::value(&o->max_descriptors_per_point)
+          ->default_value(o->max_descriptors_per_point),
+      "direct mode: descriptors indexed per map point")(
       "Localization.use_database_matches",
       po::value(&o->use_database_matches)
           ->default_value(o->use_database_matches),
@@ -442,6 +453,9 @@ bool LoadFromDatabase(const CalibrateOptions& options,
       options.sift_matching.cross_check;
   localizer_options.vocab_tree_path = options.vocab_tree_path;
   localizer_options.num_retrieved_images = options.num_retrieved_images;
+  localizer_options.index.num_checks = options.num_checks;
+  localizer_options.max_descriptors_per_point =
+      options.max_descriptors_per_point;
   localizer_options.use_database_matches = options.use_database_matches;
   localizer_options.num_threads = options.num_threads;
   if (!localizer_options.Check(error)) return false;

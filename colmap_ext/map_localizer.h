@@ -20,8 +20,8 @@
 // tests/colmap_ext/map_localizer_test.cc, map of 300 images x 2000 features,
 // rig images of 2000 features): direct costs 0.26 CPU s per image (index of
 // 360k descriptors built in ~3 s), i.e. ~7.5 images/s on 2 cores; retrieval
-// with 10 map images costs 1.85 CPU s per image. `index.num_checks` 64
-// halves the direct cost (0.14 CPU s per image).
+// with 10 map images costs 1.85 CPU s per image. These are with 128 FLANN
+// checks; the default 64 (`index.num_checks`) halves the direct cost.
 #pragma once
 
 #include <colmap/base/reconstruction.h>

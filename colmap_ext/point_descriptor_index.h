@@ -37,10 +37,13 @@ std::vector<int> SelectRepresentativeDescriptors(
 class PointDescriptorIndex {
  public:
   struct Options {
-    // FLANN kd-tree forest size and number of leaf checks per query; COLMAP's
-    // CPU matcher uses 4 trees and 128 checks.
+    // FLANN kd-tree forest size and number of leaf checks per query. COLMAP's
+    // CPU matcher uses 4 trees and 128 checks; 64 localizes twice as fast and
+    // keeps 99.4 % of the 2D-3D correspondences (rendered ring5 demo, 100 rig
+    // images of 4096 SIFT features: 190 504 -> 189 443, same calibration
+    // accuracy; 32 checks keep 98.5 %).
     int num_trees = 4;
-    int num_checks = 128;
+    int num_checks = 64;
   };
 
   // A feature matched to a map point.
