@@ -1,6 +1,8 @@
 #include "tests/testing.h"
 
 #include <boost/filesystem.hpp>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 namespace rig_calibrator {
@@ -23,6 +25,20 @@ ScopedTempDir::~ScopedTempDir() {
 
 std::string ScopedTempDir::File(const std::string& name) const {
   return path_ + "/" + name;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file),
+                     std::istreambuf_iterator<char>());
+}
+
+std::set<std::string> ListFolder(const std::string& path) {
+  std::set<std::string> names;
+  for (boost::filesystem::directory_iterator it(path), end; it != end; ++it) {
+    names.insert(it->path().filename().string());
+  }
+  return names;
 }
 
 std::string SourceDir() { return RIG_CALIBRATOR_SOURCE_DIR; }

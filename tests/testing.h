@@ -1,6 +1,7 @@
 // Helpers shared by the tests.
 #pragma once
 
+#include <set>
 #include <string>
 
 namespace rig_calibrator {
@@ -22,6 +23,12 @@ class ScopedTempDir {
  private:
   std::string path_;
 };
+
+// The bytes of a file ("" if it cannot be read).
+std::string ReadBytes(const std::string& path);
+
+// The names of the entries of a folder.
+std::set<std::string> ListFolder(const std::string& path);
 
 // The repository's root and the build tree, as configured by CMake.
 std::string SourceDir();

@@ -13,12 +13,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream file(path);
-  return std::string((std::istreambuf_iterator<char>(file)),
-                     std::istreambuf_iterator<char>());
-}
-
 size_t NumEntries(const std::string& folder) {
   return std::distance(fs::directory_iterator(folder),
                        fs::directory_iterator());
@@ -35,7 +29,7 @@ TEST(AtomicOutput, FileIsReplacedWhole) {
   std::string error;
   ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
   ASSERT_TRUE(WriteFileAtomically(path, "second", &error)) << error;
-  EXPECT_EQ(ReadFile(path), "second");
+  EXPECT_EQ(testing::ReadBytes(path), "second");
   EXPECT_EQ(NumEntries(dir.path()), 1u);
   EXPECT_FALSE(WriteFileAtomically(dir.File("missing/f.txt"), "x", &error));
 }
@@ -76,8 +70,8 @@ TEST(AtomicOutput, FolderAppearsWhole) {
   ASSERT_TRUE(WriteFolderAtomically(output, OutputFolderOptions(),
                                     WriteTwoFiles, &error))
       << error;
-  EXPECT_EQ(ReadFile(output + "/a.txt"), "a");
-  EXPECT_EQ(ReadFile(output + "/b.txt"), "b");
+  EXPECT_EQ(testing::ReadBytes(output + "/a.txt"), "a");
+  EXPECT_EQ(testing::ReadBytes(output + "/b.txt"), "b");
   EXPECT_EQ(NumEntries(dir.path()), 1u);
 
   // Non-empty: refused, then replaced with overwrite.

@@ -28,12 +28,6 @@ namespace fs = std::filesystem;
 constexpr int kNumFeatures = 40;
 constexpr int kNumMapPoints = 30;
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file),
-                     std::istreambuf_iterator<char>());
-}
-
 void WriteBytes(const std::string& path, const std::string& bytes) {
   fs::create_directories(fs::path(path).parent_path());
   std::ofstream(path, std::ios::binary) << bytes;
@@ -44,7 +38,7 @@ std::map<std::string, std::string> Snapshot(const std::string& folder) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(folder)) {
     files[entry.path().string()] =
-        entry.is_directory() ? "/" : ReadBytes(entry.path().string());
+        entry.is_directory() ? "/" : testing::ReadBytes(entry.path().string());
   }
   return files;
 }
@@ -409,7 +403,7 @@ TEST_F(CalibrateCommandBadInput, NonColmapFilesAsModel) {
   // forever looking for its terminating zero).
   const std::string truncated = inputs_ + "/truncated";
   fs::copy(map_, truncated);
-  const std::string images = ReadBytes(map_ + "/images.bin");
+  const std::string images = testing::ReadBytes(map_ + "/images.bin");
   WriteBytes(truncated + "/images.bin", images.substr(0, 8 + 64 + 6));
   ExpectFails(With(Arguments(), "--input_path", truncated),
               {truncated + "/images.bin is not a COLMAP binary model file",
@@ -419,7 +413,7 @@ TEST_F(CalibrateCommandBadInput, NonColmapFilesAsModel) {
   // models): COLMAP 3.8's reader would abort.
   const std::string new_model = inputs_ + "/new_camera_model";
   fs::copy(map_, new_model);
-  std::string cameras = ReadBytes(map_ + "/cameras.bin");
+  std::string cameras = testing::ReadBytes(map_ + "/cameras.bin");
   const int32_t unknown_model_id = 42;
   cameras.replace(8 + 4, 4, reinterpret_cast<const char*>(&unknown_model_id),
                   4);

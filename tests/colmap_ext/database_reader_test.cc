@@ -16,20 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file),
-                     std::istreambuf_iterator<char>());
-}
-
-std::set<std::string> ListFolder(const std::string& path) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(path)) {
-    names.insert(entry.path().filename().string());
-  }
-  return names;
-}
-
 // Runs SQL on a database the test owns (never on a database under test
 // through the reader).
 void ExecuteSql(const std::string& path, const std::string& sql) {
@@ -184,9 +170,10 @@ TEST_F(DatabaseReaderTest, ReadsInlierMatchesInTheRequestedOrder) {
 }
 
 TEST_F(DatabaseReaderTest, LeavesTheDatabaseAndItsFolderUntouched) {
-  const std::string bytes_before = ReadBytes(path_);
+  const std::string bytes_before = testing::ReadBytes(path_);
   const auto mtime_before = fs::last_write_time(path_);
-  const std::set<std::string> files_before = ListFolder(temp_dir_.path());
+  const std::set<std::string> files_before =
+      testing::ListFolder(temp_dir_.path());
   {
     DatabaseReader reader;
     std::string error;
@@ -196,9 +183,9 @@ TEST_F(DatabaseReaderTest, LeavesTheDatabaseAndItsFolderUntouched) {
     ASSERT_TRUE(reader.ReadDescriptors(3, &descriptors, &error));
     ASSERT_TRUE(reader.ReadInlierMatches(3, 1, &matches, &error));
   }
-  EXPECT_EQ(ReadBytes(path_), bytes_before);
+  EXPECT_EQ(testing::ReadBytes(path_), bytes_before);
   EXPECT_EQ(fs::last_write_time(path_), mtime_before);
-  EXPECT_EQ(ListFolder(temp_dir_.path()), files_before);
+  EXPECT_EQ(testing::ListFolder(temp_dir_.path()), files_before);
 }
 
 TEST_F(DatabaseReaderTest, ReadsDataStillInTheWriteAheadLog) {

@@ -24,20 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file),
-                     std::istreambuf_iterator<char>());
-}
-
-std::set<std::string> ListFolder(const std::string& path) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(path)) {
-    names.insert(entry.path().filename().string());
-  }
-  return names;
-}
-
 struct SceneConfig {
   int num_map_images = 12;
   int num_points = 1000;
@@ -491,9 +477,10 @@ TEST_F(MapLocalizerTest, UsesVerifiedMatchesStoredInTheDatabase) {
 
 TEST_F(MapLocalizerTest, NeverModifiesTheDatabase) {
   reader_.Close();
-  const std::string bytes_before = ReadBytes(database_path_);
+  const std::string bytes_before = testing::ReadBytes(database_path_);
   const auto mtime_before = fs::last_write_time(database_path_);
-  const std::set<std::string> files_before = ListFolder(temp_dir_.path());
+  const std::set<std::string> files_before =
+      testing::ListFolder(temp_dir_.path());
   std::string error;
   ASSERT_TRUE(reader_.Open(database_path_, &error)) << error;
   for (const LocalizationMode mode :
@@ -505,9 +492,9 @@ TEST_F(MapLocalizerTest, NeverModifiesTheDatabase) {
     EXPECT_EQ(LocalizeAll(options).size(), scene_.rig_image_names.size());
   }
   reader_.Close();
-  EXPECT_EQ(ReadBytes(database_path_), bytes_before);
+  EXPECT_EQ(testing::ReadBytes(database_path_), bytes_before);
   EXPECT_EQ(fs::last_write_time(database_path_), mtime_before);
-  EXPECT_EQ(ListFolder(temp_dir_.path()), files_before);
+  EXPECT_EQ(testing::ListFolder(temp_dir_.path()), files_before);
 }
 
 TEST_F(MapLocalizerTest, ReportsMissingRigImagesAndFeatures) {

@@ -161,12 +161,6 @@ Scene MakeScene() {
   return scene;
 }
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)),
-                     std::istreambuf_iterator<char>());
-}
-
 size_t NumObservations(const colmap::Reconstruction& model) {
   size_t count = 0;
   for (const auto& [image_id, image] : model.Images()) {
@@ -335,12 +329,12 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
   if (!binary) {
     // The exact text of COLMAP >= 3.12: trivial rig and frame lines, single
     // spaces, no trailing space.
-    const std::string rigs = ReadFile(output + "/rigs.txt");
+    const std::string rigs = testing::ReadBytes(output + "/rigs.txt");
     EXPECT_NE(rigs.find("# Number of rigs: 2\n1 1 CAMERA 1\n5 3 CAMERA 2 "
                         "CAMERA 3 1 "),
               std::string::npos)
         << rigs;
-    const std::string frames = ReadFile(output + "/frames.txt");
+    const std::string frames = testing::ReadBytes(output + "/frames.txt");
     std::istringstream lines(frames);
     std::string line;
     int num_data_lines = 0;
