@@ -468,6 +468,12 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
   // (relative to the whole parameter vector, dominated by the focal lengths)
   // would stop a few digits short.
   solver_options.parameter_tolerance = 1e-12;
+  // Stop when an iteration lowers the cost by less than 1e-5 of it (Ceres'
+  // default 1e-6). With refined map points the last iterations only polish
+  // tens of thousands of points: 500 framesets x 10 cameras, final BA 58 s ->
+  // 40 s, 200 x 10: 24 -> 12 s, with the same errors against the truth (and
+  // the same on the rendered demo); exact data still converge to 1e-8.
+  solver_options.function_tolerance = 1e-5;
 
   // Schur elimination group: the variable points when refined (each is seen
   // by several framesets, so the rig poses cannot share the group: the group
