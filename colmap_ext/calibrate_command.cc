@@ -525,7 +525,9 @@ void PrintResult(const RigDataset& dataset, const RigCalibration& calibration,
             << " images used, " << report.num_framesets_posed << " of "
             << dataset.frameset_names.size() << " framesets, RMS "
             << std::setprecision(3) << report.final_rms_px << " px, "
-            << std::setprecision(1) << report.total_seconds << " s)\n";
+            << std::fixed << std::setprecision(1) << report.total_seconds
+            << " s)\n"
+            << std::defaultfloat;
   for (const CameraSummary& camera : summary.cameras) {
     std::cout << "  " << std::left << std::setw(8) << camera.name << std::right;
     if (!camera.calibrated) {
