@@ -23,6 +23,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <boost/filesystem.hpp>
 #include <boost/program_options.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -423,12 +424,18 @@ int RunParent(const BenchmarkOptions& options,
               << code.message() << std::endl;
     return EXIT_FAILURE;
   }
-  char work_template[] = "/tmp/rig_calibrator_runtime_XXXXXX";
-  if (mkdtemp(work_template) == nullptr) {
-    std::cerr << "ERROR: cannot create a temporary folder" << std::endl;
+  // The children's results and databases go to a fresh folder in the
+  // system's temporary folder ($TMPDIR), removed at the end.
+  const std::string work_dir =
+      (fs::temp_directory_path(code) /
+       boost::filesystem::unique_path("rig_calibrator_runtime_%%%%-%%%%-%%%%")
+           .string())
+          .string();
+  if (code || !fs::create_directory(work_dir, code) || code) {
+    std::cerr << "ERROR: cannot create a temporary folder " << work_dir
+              << (code ? ": " + code.message() : "") << std::endl;
     return EXIT_FAILURE;
   }
-  const std::string work_dir = work_template;
   const std::string machine_before = MachineDescription();
   std::cout << "Runtime benchmark (" << machine_before << ")" << std::endl;
 
