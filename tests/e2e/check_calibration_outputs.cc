@@ -32,10 +32,10 @@
 #include <string>
 #include <vector>
 
-#include "colmap_ext/camchain_io.h"
-#include "colmap_ext/rig_config_io.h"
-#include "colmap_ext/rigs_frames_io.h"
-#include "src/rigid3d.h"
+#include "colmap_ext/io/camchain_io.h"
+#include "colmap_ext/io/rig_config_io.h"
+#include "colmap_ext/io/rigs_frames_io.h"
+#include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
 namespace {

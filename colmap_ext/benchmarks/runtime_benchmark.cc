@@ -1,0 +1,427 @@
+#include "colmap_ext/benchmarks/runtime_benchmark.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "src/experiments/svg_plot.h"
+
+namespace rig_calibrator {
+namespace {
+
+constexpr char kCalibrationHeader[] = "rig_calibrator calibration runtime";
+constexpr char kLocalizationHeader[] = "rig_calibrator localization runtime";
+
+// One line of text (newlines would break the line-based format).
+std::string OneLine(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
+  return text;
+}
+
+std::string Fixed(double value, int digits) {
+  if (!std::isfinite(value)) return "-";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
+// Key-value lines after a header line; "key rest of the line".
+class Fields {
+ public:
+  bool Parse(const std::string& text, const std::string& header,
+             std::string* error) {
+    std::istringstream stream(text);
+    std::string line;
+    if (!std::getline(stream, line) || line != header) {
+      *error =
+          "not a serialized result (expected the header \"" + header + "\")";
+      return false;
+    }
+    while (std::getline(stream, line)) {
+      if (line.empty()) continue;
+      const size_t space = line.find(' ');
+      const std::string key = line.substr(0, space);
+      const std::string value =
+          space == std::string::npos ? "" : line.substr(space + 1);
+      if (key == "stage") {
+        stages_.push_back(value);
+      } else {
+        values_[key] = value;
+      }
+    }
+    return true;
+  }
+
+  bool Number(const std::string& key, double* value, std::string* error) {
+    const auto it = values_.find(key);
+    if (it == values_.end()) {
+      *error = "missing field " + key;
+      return false;
+    }
+    std::istringstream stream(it->second);
+    if (!(stream >> *value)) {
+      *error = "field " + key + " is not a number: " + it->second;
+      return false;
+    }
+    return true;
+  }
+
+  template <typename Integer>
+  bool Integral(const std::string& key, Integer* value, std::string* error) {
+    double number = 0;
+    if (!Number(key, &number, error)) return false;
+    *value = static_cast<Integer>(std::llround(number));
+    return true;
+  }
+
+  std::string Text(const std::string& key) const {
+    const auto it = values_.find(key);
+    return it == values_.end() ? "" : it->second;
+  }
+
+  const std::vector<std::string>& stages() const { return stages_; }
+
+ private:
+  std::map<std::string, std::string> values_;
+  std::vector<std::string> stages_;
+};
+
+// Stage names over all runs, in order of first appearance.
+std::vector<std::string> StageNames(
+    const std::vector<CalibrationRuntime>& runs) {
+  std::vector<std::string> names;
+  for (const CalibrationRuntime& run : runs) {
+    for (const StageRuntime& stage : run.stages) {
+      if (std::find(names.begin(), names.end(), stage.stage) == names.end()) {
+        names.push_back(stage.stage);
+      }
+    }
+  }
+  return names;
+}
+
+// Wall and CPU seconds of a stage in a run (NaN if it did not run); a stage
+// that ran twice (a fallback) counts with its total.
+std::pair<double, double> StageSeconds(const CalibrationRuntime& run,
+                                       const std::string& name) {
+  double seconds = 0, cpu_seconds = 0;
+  bool found = false;
+  for (const StageRuntime& stage : run.stages) {
+    if (stage.stage != name) continue;
+    seconds += stage.seconds;
+    cpu_seconds += stage.cpu_seconds;
+    found = true;
+  }
+  if (!found) return {std::nan(""), std::nan("")};
+  return {seconds, cpu_seconds};
+}
+
+std::set<int> CameraCounts(const std::vector<CalibrationRuntime>& runs) {
+  std::set<int> counts;
+  for (const CalibrationRuntime& run : runs) counts.insert(run.num_cameras);
+  return counts;
+}
+
+}  // namespace
+
+std::string SerializeCalibrationRuntime(const CalibrationRuntime& runtime) {
+  std::ostringstream text;
+  text << std::setprecision(10) << kCalibrationHeader << "\n"
+       << "num_framesets " << runtime.num_framesets << "\n"
+       << "num_cameras " << runtime.num_cameras << "\n"
+       << "num_images " << runtime.num_images << "\n"
+       << "num_correspondences " << runtime.num_correspondences << "\n"
+       << "generation_seconds " << runtime.generation_seconds << "\n"
+       << "seconds " << runtime.seconds << "\n"
+       << "cpu_seconds " << runtime.cpu_seconds << "\n"
+       << "peak_memory_mb " << runtime.peak_memory_mb << "\n"
+       << "success " << (runtime.success ? 1 : 0) << "\n"
+       << "final_rms_px " << runtime.final_rms_px << "\n"
+       << "max_rotation_error_deg " << runtime.max_rotation_error_deg << "\n"
+       << "max_center_error_m " << runtime.max_center_error_m << "\n"
+       << "error " << OneLine(runtime.error) << "\n";
+  for (const StageRuntime& stage : runtime.stages) {
+    text << "stage " << stage.seconds << " " << stage.cpu_seconds << " "
+         << OneLine(stage.stage) << "\n";
+  }
+  return text.str();
+}
+
+bool ParseCalibrationRuntime(const std::string& text,
+                             CalibrationRuntime* runtime, std::string* error) {
+  Fields fields;
+  CalibrationRuntime parsed;
+  int success = 0;
+  if (!fields.Parse(text, kCalibrationHeader, error) ||
+      !fields.Integral("num_framesets", &parsed.num_framesets, error) ||
+      !fields.Integral("num_cameras", &parsed.num_cameras, error) ||
+      !fields.Integral("num_images", &parsed.num_images, error) ||
+      !fields.Integral("num_correspondences", &parsed.num_correspondences,
+                       error) ||
+      !fields.Number("generation_seconds", &parsed.generation_seconds, error) ||
+      !fields.Number("seconds", &parsed.seconds, error) ||
+      !fields.Number("cpu_seconds", &parsed.cpu_seconds, error) ||
+      !fields.Number("peak_memory_mb", &parsed.peak_memory_mb, error) ||
+      !fields.Integral("success", &success, error) ||
+      !fields.Number("final_rms_px", &parsed.final_rms_px, error) ||
+      !fields.Number("max_rotation_error_deg", &parsed.max_rotation_error_deg,
+                     error) ||
+      !fields.Number("max_center_error_m", &parsed.max_center_error_m, error)) {
+    return false;
+  }
+  parsed.success = success != 0;
+  parsed.error = fields.Text("error");
+  for (const std::string& line : fields.stages()) {
+    std::istringstream stream(line);
+    StageRuntime stage;
+    if (!(stream >> stage.seconds >> stage.cpu_seconds)) {
+      *error = "malformed stage line: " + line;
+      return false;
+    }
+    std::getline(stream >> std::ws, stage.stage);
+    parsed.stages.push_back(stage);
+  }
+  *runtime = parsed;
+  return true;
+}
+
+std::string SerializeLocalizationRuntime(const LocalizationRuntime& runtime) {
+  std::ostringstream text;
+  text << std::setprecision(10) << kLocalizationHeader << "\n"
+       << "mode " << OneLine(runtime.mode) << "\n"
+       << "num_map_images " << runtime.num_map_images << "\n"
+       << "num_map_points " << runtime.num_map_points << "\n"
+       << "num_indexed_descriptors " << runtime.num_indexed_descriptors << "\n"
+       << "features_per_rig_image " << runtime.features_per_rig_image << "\n"
+       << "num_checks " << runtime.num_checks << "\n"
+       << "num_images " << runtime.num_images << "\n"
+       << "index_seconds " << runtime.index_seconds << "\n"
+       << "index_cpu_seconds " << runtime.index_cpu_seconds << "\n"
+       << "seconds " << runtime.seconds << "\n"
+       << "cpu_seconds " << runtime.cpu_seconds << "\n"
+       << "recall " << runtime.recall << "\n"
+       << "precision " << runtime.precision << "\n"
+       << "radial_pose_seconds_per_image "
+       << runtime.radial_pose_seconds_per_image << "\n"
+       << "num_poses_correct " << runtime.num_poses_correct << "\n"
+       << "peak_memory_mb " << runtime.peak_memory_mb << "\n";
+  return text.str();
+}
+
+bool ParseLocalizationRuntime(const std::string& text,
+                              LocalizationRuntime* runtime,
+                              std::string* error) {
+  Fields fields;
+  LocalizationRuntime parsed;
+  if (!fields.Parse(text, kLocalizationHeader, error) ||
+      !fields.Integral("num_map_images", &parsed.num_map_images, error) ||
+      !fields.Integral("num_map_points", &parsed.num_map_points, error) ||
+      !fields.Integral("num_indexed_descriptors",
+                       &parsed.num_indexed_descriptors, error) ||
+      !fields.Integral("features_per_rig_image", &parsed.features_per_rig_image,
+                       error) ||
+      !fields.Integral("num_checks", &parsed.num_checks, error) ||
+      !fields.Integral("num_images", &parsed.num_images, error) ||
+      !fields.Number("index_seconds", &parsed.index_seconds, error) ||
+      !fields.Number("index_cpu_seconds", &parsed.index_cpu_seconds, error) ||
+      !fields.Number("seconds", &parsed.seconds, error) ||
+      !fields.Number("cpu_seconds", &parsed.cpu_seconds, error) ||
+      !fields.Number("recall", &parsed.recall, error) ||
+      !fields.Number("precision", &parsed.precision, error) ||
+      !fields.Number("radial_pose_seconds_per_image",
+                     &parsed.radial_pose_seconds_per_image, error) ||
+      !fields.Integral("num_poses_correct", &parsed.num_poses_correct, error) ||
+      !fields.Number("peak_memory_mb", &parsed.peak_memory_mb, error)) {
+    return false;
+  }
+  parsed.mode = fields.Text("mode");
+  *runtime = parsed;
+  return true;
+}
+
+std::string CalibrationRuntimeCsv(const std::vector<CalibrationRuntime>& runs) {
+  const std::vector<std::string> stages = StageNames(runs);
+  std::ostringstream csv;
+  csv << "framesets,cameras,images,correspondences,success";
+  for (const std::string& stage : stages) {
+    csv << ",\"" << stage << " wall s\",\"" << stage << " CPU s\"";
+  }
+  csv << ",total wall s,total CPU s,peak memory MB,final RMS px,"
+         "max rotation error deg,max center error m\n";
+  for (const CalibrationRuntime& run : runs) {
+    csv << run.num_framesets << "," << run.num_cameras << "," << run.num_images
+        << "," << run.num_correspondences << "," << (run.success ? 1 : 0);
+    for (const std::string& stage : stages) {
+      const auto [seconds, cpu_seconds] = StageSeconds(run, stage);
+      csv << "," << (std::isfinite(seconds) ? Fixed(seconds, 3) : "") << ","
+          << (std::isfinite(cpu_seconds) ? Fixed(cpu_seconds, 3) : "");
+    }
+    csv << "," << Fixed(run.seconds, 3) << "," << Fixed(run.cpu_seconds, 3)
+        << "," << Fixed(run.peak_memory_mb, 1) << ","
+        << Fixed(run.final_rms_px, 4) << ","
+        << Fixed(run.max_rotation_error_deg, 4) << ","
+        << Fixed(run.max_center_error_m, 5) << "\n";
+  }
+  return csv.str();
+}
+
+std::string LocalizationRuntimeCsv(
+    const std::vector<LocalizationRuntime>& runs) {
+  std::ostringstream csv;
+  csv << "mode,map images,map points,indexed descriptors,features per rig "
+         "image,checks,rig images,index wall s,index CPU s,localization wall s,"
+         "localization CPU s,images per s,CPU s per image,recall,precision,"
+         "radial pose s per image,poses correct,peak memory MB\n";
+  for (const LocalizationRuntime& run : runs) {
+    const double per_image =
+        run.num_images > 0 ? run.cpu_seconds / run.num_images : std::nan("");
+    csv << run.mode << "," << run.num_map_images << "," << run.num_map_points
+        << "," << run.num_indexed_descriptors << ","
+        << run.features_per_rig_image << "," << run.num_checks << ","
+        << run.num_images << "," << Fixed(run.index_seconds, 3) << ","
+        << Fixed(run.index_cpu_seconds, 3) << "," << Fixed(run.seconds, 3)
+        << "," << Fixed(run.cpu_seconds, 3) << ","
+        << Fixed(run.ImagesPerSecond(), 2) << "," << Fixed(per_image, 4) << ","
+        << Fixed(run.recall, 4) << "," << Fixed(run.precision, 4) << ","
+        << Fixed(run.radial_pose_seconds_per_image, 5) << ","
+        << run.num_poses_correct << "," << Fixed(run.peak_memory_mb, 1) << "\n";
+  }
+  return csv.str();
+}
+
+double GrowthExponent(const std::vector<CalibrationRuntime>& runs,
+                      int num_cameras) {
+  const CalibrationRuntime* smallest = nullptr;
+  const CalibrationRuntime* largest = nullptr;
+  for (const CalibrationRuntime& run : runs) {
+    if (run.num_cameras != num_cameras || !run.success ||
+        run.cpu_seconds <= 0) {
+      continue;
+    }
+    if (smallest == nullptr || run.num_framesets < smallest->num_framesets) {
+      smallest = &run;
+    }
+    if (largest == nullptr || run.num_framesets > largest->num_framesets) {
+      largest = &run;
+    }
+  }
+  if (smallest == nullptr ||
+      smallest->num_framesets == largest->num_framesets) {
+    return std::nan("");
+  }
+  return std::log(largest->cpu_seconds / smallest->cpu_seconds) /
+         std::log(static_cast<double>(largest->num_framesets) /
+                  smallest->num_framesets);
+}
+
+std::string CalibrationRuntimeMarkdown(
+    const std::vector<CalibrationRuntime>& runs) {
+  const std::vector<std::string> stages = StageNames(runs);
+  std::ostringstream md;
+  md << "| framesets | cameras | images | correspondences |";
+  for (const std::string& stage : stages) md << " " << stage << " |";
+  md << " total wall s | total CPU s | peak memory MB | final RMS px | "
+        "max rotation error deg | max center error mm |\n|---|---|---|---|";
+  for (size_t s = 0; s < stages.size(); ++s) md << "---|";
+  md << "---|---|---|---|---|---|\n";
+  for (const CalibrationRuntime& run : runs) {
+    md << "| " << run.num_framesets << " | " << run.num_cameras << " | "
+       << run.num_images << " | " << run.num_correspondences << " |";
+    for (const std::string& stage : stages) {
+      const auto [seconds, cpu_seconds] = StageSeconds(run, stage);
+      md << " " << Fixed(seconds, 2) << " (" << Fixed(cpu_seconds, 2) << ") |";
+    }
+    md << " " << Fixed(run.seconds, 2) << " | " << Fixed(run.cpu_seconds, 2)
+       << " | " << Fixed(run.peak_memory_mb, 0) << " | ";
+    if (run.success) {
+      md << Fixed(run.final_rms_px, 3) << " | "
+         << Fixed(run.max_rotation_error_deg, 3) << " | "
+         << Fixed(1000 * run.max_center_error_m, 2) << " |\n";
+    } else {
+      md << "failed: " << run.error << " | - | - |\n";
+    }
+  }
+  md << "\nStage cells: wall seconds (CPU seconds, user + system over all "
+        "threads).\n";
+  for (const int num_cameras : CameraCounts(runs)) {
+    const double exponent = GrowthExponent(runs, num_cameras);
+    if (std::isfinite(exponent)) {
+      md << "Growth with " << num_cameras << " cameras: CPU time ~ framesets^"
+         << Fixed(exponent, 2)
+         << " between the smallest and the largest run (1 = linear).\n";
+    }
+  }
+  return md.str();
+}
+
+std::string LocalizationRuntimeMarkdown(
+    const std::vector<LocalizationRuntime>& runs) {
+  std::ostringstream md;
+  md << "| mode | map images | map points | features per rig image | "
+        "checks | rig images | index built in s (CPU s) | images/s (wall) | "
+        "CPU s per "
+        "image | recall | precision | radial pose ms per image | poses "
+        "within 0.5 deg | peak memory MB |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const LocalizationRuntime& run : runs) {
+    const double per_image =
+        run.num_images > 0 ? run.cpu_seconds / run.num_images : std::nan("");
+    md << "| " << run.mode << " | " << run.num_map_images << " | "
+       << run.num_map_points << " | " << run.features_per_rig_image << " | "
+       << (run.mode == "direct" ? std::to_string(run.num_checks) : "-") << " | "
+       << run.num_images << " | " << Fixed(run.index_seconds, 2) << " ("
+       << Fixed(run.index_cpu_seconds, 2) << ") | "
+       << Fixed(run.ImagesPerSecond(), 2) << " | " << Fixed(per_image, 3)
+       << " | " << Fixed(run.recall, 3) << " | " << Fixed(run.precision, 3)
+       << " | " << Fixed(1000 * run.radial_pose_seconds_per_image, 2) << " | "
+       << run.num_poses_correct << "/" << run.num_images << " | "
+       << Fixed(run.peak_memory_mb, 0) << " |\n";
+  }
+  return md.str();
+}
+
+std::string CalibrationRuntimeSvg(const std::vector<CalibrationRuntime>& runs) {
+  std::vector<PlotSeries> series;
+  double y_max = 0;
+  for (const int num_cameras : CameraCounts(runs)) {
+    std::vector<const CalibrationRuntime*> selected;
+    for (const CalibrationRuntime& run : runs) {
+      if (run.num_cameras == num_cameras && run.success) {
+        selected.push_back(&run);
+      }
+    }
+    std::sort(selected.begin(), selected.end(),
+              [](const CalibrationRuntime* a, const CalibrationRuntime* b) {
+                return a->num_framesets < b->num_framesets;
+              });
+    PlotSeries wall, cpu;
+    wall.label = std::to_string(num_cameras) + " cameras, wall";
+    cpu.label = std::to_string(num_cameras) + " cameras, CPU";
+    for (const CalibrationRuntime* run : selected) {
+      wall.x.push_back(run->num_framesets);
+      wall.y.push_back(run->seconds);
+      cpu.x.push_back(run->num_framesets);
+      cpu.y.push_back(run->cpu_seconds);
+      y_max = std::max({y_max, run->seconds, run->cpu_seconds});
+    }
+    series.push_back(wall);
+    series.push_back(cpu);
+  }
+  PlotOptions options;
+  options.title = "Calibration core (CalibrateRig) time vs framesets";
+  options.x_label = "framesets";
+  options.y_label = "seconds";
+  options.x_min = 0;
+  options.y_min = 0;
+  // Headroom above the highest point, which would sit on the frame.
+  if (y_max > 0) options.y_max = 1.1 * y_max;
+  return LinePlotSvg(options, series);
+}
+
+}  // namespace rig_calibrator

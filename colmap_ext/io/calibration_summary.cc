@@ -1,0 +1,122 @@
+#include "colmap_ext/io/calibration_summary.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/rig_description.h"
+
+namespace rig_calibrator {
+
+CalibrationSummary SummarizeCalibration(
+    const RigDataset& dataset, const RigCalibration& calibration,
+    const std::vector<std::string>& image_prefixes) {
+  CalibrationSummary summary;
+  const RigDescription rig =
+      DescribeCalibratedRig(dataset, calibration, image_prefixes);
+  summary.reference_camera = dataset.cameras[dataset.reference_camera].name;
+  summary.num_framesets = static_cast<int>(dataset.frameset_names.size());
+  for (const std::optional<Rigid3d>& pose : calibration.rig_from_world) {
+    summary.num_framesets_used += pose.has_value() ? 1 : 0;
+  }
+
+  // Sums of squared errors, pooled over the inliers of each camera's used
+  // images: rms = sqrt(sum_i n_i rms_i^2 / sum_i n_i).
+  std::vector<double> radial_sum(dataset.cameras.size(), 0);
+  std::vector<double> full_sum(dataset.cameras.size(), 0);
+  summary.cameras.resize(dataset.cameras.size());
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    CameraSummary& camera = summary.cameras[c];
+    camera.name = rig.cameras[c].name;
+    camera.image_prefix = rig.cameras[c].image_prefix;
+    camera.calibrated = calibration.camera_calibrated[c];
+    camera.camera =
+        camera.calibrated ? calibration.cameras[c] : dataset.cameras[c].camera;
+    camera.cam_from_rig = rig.cameras[c].cam_from_rig;
+  }
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const int c = dataset.images[i].camera_index;
+    const ImageResult& result = calibration.images[i];
+    CameraSummary& camera = summary.cameras[c];
+    ++camera.num_images;
+    camera.num_localized += result.localized ? 1 : 0;
+    if (!result.used) continue;
+    ++camera.num_used;
+    camera.num_inliers += result.num_inliers;
+    radial_sum[c] +=
+        result.num_inliers * result.radial_rms_px * result.radial_rms_px;
+    full_sum[c] += result.num_inliers * result.rms_px * result.rms_px;
+  }
+  for (size_t c = 0; c < summary.cameras.size(); ++c) {
+    CameraSummary& camera = summary.cameras[c];
+    if (camera.num_inliers > 0) {
+      camera.radial_rms_px = std::sqrt(radial_sum[c] / camera.num_inliers);
+      camera.rms_px = std::sqrt(full_sum[c] / camera.num_inliers);
+    }
+  }
+  return summary;
+}
+
+bool WriteCalibrationSummaryJson(const std::string& path,
+                                 const CalibrationSummary& summary,
+                                 std::string* error) {
+  using Json = nlohmann::ordered_json;
+  // JSON has no NaN or infinity; a non-finite value becomes null.
+  auto number = [](double value) {
+    return std::isfinite(value) ? Json(value) : Json(nullptr);
+  };
+  Json root;
+  root["method"] = summary.method;
+  root["units"] = summary.units;
+  root["map_looks_metric"] = summary.map_looks_metric
+                                 ? Json(*summary.map_looks_metric)
+                                 : Json(nullptr);
+  root["reference_camera"] = summary.reference_camera;
+  root["num_framesets"] = summary.num_framesets;
+  root["num_framesets_used"] = summary.num_framesets_used;
+  Json cameras = Json::array();
+  for (const CameraSummary& camera : summary.cameras) {
+    Json node;
+    node["name"] = camera.name;
+    node["image_prefix"] = camera.image_prefix;
+    node["calibrated"] = camera.calibrated;
+    node["model"] = camera.camera.ModelName();
+    node["width"] = camera.camera.Width();
+    node["height"] = camera.camera.Height();
+    node["params"] = Json::array();
+    for (const double param : camera.camera.Params()) {
+      node["params"].push_back(number(param));
+    }
+    if (camera.cam_from_rig) {
+      const Rigid3d& pose = *camera.cam_from_rig;
+      node["cam_from_rig"] = {
+          {"rotation_wxyz",
+           {number(pose.rotation.w()), number(pose.rotation.x()),
+            number(pose.rotation.y()), number(pose.rotation.z())}},
+          {"translation",
+           {number(pose.translation.x()), number(pose.translation.y()),
+            number(pose.translation.z())}}};
+    } else {
+      node["cam_from_rig"] = nullptr;
+    }
+    node["num_images"] = camera.num_images;
+    node["num_localized"] = camera.num_localized;
+    node["num_used"] = camera.num_used;
+    node["num_inliers"] = camera.num_inliers;
+    node["radial_rms_px"] = number(camera.radial_rms_px);
+    node["rms_px"] = number(camera.rms_px);
+    cameras.push_back(node);
+  }
+  root["cameras"] = cameras;
+  root["diagnostics"] = summary.diagnostics;
+  Json timings = Json::object();
+  for (const auto& [stage, seconds] : summary.timings_s) {
+    timings[stage] = number(seconds);
+  }
+  root["timings_s"] = timings;
+  return WriteFileAtomically(
+      path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
+      error);
+}
+
+}  // namespace rig_calibrator

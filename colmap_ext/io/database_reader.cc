@@ -1,0 +1,493 @@
+#include "colmap_ext/io/database_reader.h"
+
+#include <colmap/base/camera_models.h>
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace rig_calibrator {
+namespace {
+
+// COLMAP's kMaxNumImages (base/database.h): pair ids are
+// kMaxNumImages * min_id + max_id.
+constexpr uint64_t kMaxNumImages = 2147483647;
+
+// Tables that only databases of newer COLMAP versions have: rigs and frames
+// (3.12), pose_priors (3.10, when the prior_* columns left `images`).
+const char* const kNewerColmapTables[] = {"rigs", "frames", "pose_priors"};
+const char* const kColmap38Tables[] = {"cameras",   "images",
+                                       "keypoints", "descriptors",
+                                       "matches",   "two_view_geometries"};
+
+// Percent-encodes a file path for an SQLite "file:" URI (RFC 3986 unreserved
+// characters and '/' stay as they are).
+std::string EscapeUriPath(const std::string& path) {
+  static const char kHex[] = "0123456789ABCDEF";
+  std::string escaped;
+  for (const unsigned char c : path) {
+    if (std::isalnum(c) || c == '/' || c == '-' || c == '_' || c == '.' ||
+        c == '~') {
+      escaped += static_cast<char>(c);
+    } else {
+      escaped += '%';
+      escaped += kHex[c >> 4];
+      escaped += kHex[c & 15];
+    }
+  }
+  return escaped;
+}
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string joined;
+  for (const std::string& name : names) {
+    joined += (joined.empty() ? "" : ", ") + name;
+  }
+  return joined;
+}
+
+// Resets and clears the bindings of a statement when leaving a scope, so a
+// cached statement never keeps a read transaction open.
+class StatementScope {
+ public:
+  explicit StatementScope(sqlite3_stmt* statement) : statement_(statement) {}
+  ~StatementScope() {
+    sqlite3_reset(statement_);
+    sqlite3_clear_bindings(statement_);
+  }
+
+ private:
+  sqlite3_stmt* statement_;
+};
+
+}  // namespace
+
+DatabaseReader::DatabaseReader() = default;
+
+DatabaseReader::~DatabaseReader() { Close(); }
+
+void DatabaseReader::Close() {
+  for (sqlite3_stmt** statement :
+       {&read_camera_, &count_keypoints_, &count_descriptors_, &read_keypoints_,
+        &read_descriptors_, &read_inlier_matches_}) {
+    sqlite3_finalize(*statement);
+    *statement = nullptr;
+  }
+  if (database_ != nullptr) {
+    sqlite3_close(database_);
+    database_ = nullptr;
+  }
+  images_.clear();
+  image_index_by_name_.clear();
+  image_index_by_id_.clear();
+  user_version_ = 0;
+}
+
+bool DatabaseReader::Open(const std::string& path, std::string* error) {
+  namespace fs = std::filesystem;
+  Close();
+  path_ = path;
+  const std::string prefix = "database " + path + ": ";
+
+  std::error_code fs_error;
+  if (!fs::exists(path, fs_error)) {
+    *error = prefix + "no such file";
+    return false;
+  }
+  if (!fs::is_regular_file(path, fs_error)) {
+    *error = prefix + "not a regular file";
+    return false;
+  }
+  // An SQLite file starts with this 16-byte header; checking it first gives
+  // a clear message instead of SQLite's "file is not a database".
+  static const char kSqliteHeader[16] = "SQLite format 3";
+  char header[16] = {};
+  {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) {
+      *error = prefix + "cannot be opened for reading";
+      return false;
+    }
+    file.read(header, sizeof(header));
+    if (file.gcount() != sizeof(header) ||
+        std::memcmp(header, kSqliteHeader, sizeof(header)) != 0) {
+      *error = prefix +
+               "not an SQLite file, so not a COLMAP database (create one with "
+               "`colmap feature_extractor --database_path ...`)";
+      return false;
+    }
+  }
+
+  // COLMAP leaves its databases in WAL mode. A read-only connection to a WAL
+  // database creates "-shm"/"-wal" files next to it; `immutable=1` avoids
+  // that (no locks, no side files). A non-empty "-wal" file holds committed
+  // data not yet copied into the database (COLMAP still running or killed),
+  // which only a normal read-only connection reads.
+  const fs::path wal_path = path + "-wal";
+  const bool has_pending_wal =
+      fs::exists(wal_path, fs_error) && fs::file_size(wal_path, fs_error) > 0;
+  const std::string absolute_path = fs::absolute(path, fs_error).string();
+  const std::string uri =
+      "file:" + EscapeUriPath(absolute_path) +
+      (has_pending_wal ? "?mode=ro" : "?mode=ro&immutable=1");
+  if (sqlite3_open_v2(
+          uri.c_str(), &database_,
+          SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_FULLMUTEX,
+          nullptr) != SQLITE_OK) {
+    *error = prefix + "SQLite cannot open it read-only: " +
+             (database_ != nullptr ? sqlite3_errmsg(database_) : "no memory");
+    Close();
+    return false;
+  }
+
+  if (!CheckSchema(error) || !ReadImages(error)) {
+    *error = prefix + *error;
+    Close();
+    return false;
+  }
+
+  const struct {
+    sqlite3_stmt** statement;
+    const char* sql;
+  } statements[] = {
+      {&read_camera_,
+       "SELECT model, width, height, params, prior_focal_length FROM cameras "
+       "WHERE camera_id = ?;"},
+      {&count_keypoints_, "SELECT rows FROM keypoints WHERE image_id = ?;"},
+      {&count_descriptors_, "SELECT rows FROM descriptors WHERE image_id = ?;"},
+      {&read_keypoints_,
+       "SELECT rows, cols, data FROM keypoints WHERE image_id = ?;"},
+      {&read_descriptors_,
+       "SELECT rows, cols, data FROM descriptors WHERE image_id = ?;"},
+      {&read_inlier_matches_,
+       "SELECT rows, cols, data FROM two_view_geometries WHERE pair_id = ?;"},
+  };
+  for (const auto& [statement, sql] : statements) {
+    if (sqlite3_prepare_v2(database_, sql, -1, statement, nullptr) !=
+        SQLITE_OK) {
+      *error = prefix + "unexpected schema: " + sqlite3_errmsg(database_);
+      Close();
+      return false;
+    }
+  }
+  return true;
+}
+
+bool DatabaseReader::CheckSchema(std::string* error) {
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT name FROM sqlite_master WHERE type='table';",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    *error = std::string("not a readable SQLite database: ") +
+             sqlite3_errmsg(database_);
+    return false;
+  }
+  std::set<std::string> tables;
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    tables.insert(
+        reinterpret_cast<const char*>(sqlite3_column_text(statement, 0)));
+  }
+  sqlite3_finalize(statement);
+
+  if (sqlite3_prepare_v2(database_, "PRAGMA user_version;", -1, &statement,
+                         nullptr) == SQLITE_OK &&
+      sqlite3_step(statement) == SQLITE_ROW) {
+    user_version_ = sqlite3_column_int(statement, 0);
+  }
+  sqlite3_finalize(statement);
+
+  std::vector<std::string> newer_tables;
+  for (const char* table : kNewerColmapTables) {
+    if (tables.count(table) > 0) newer_tables.push_back(table);
+  }
+  bool images_has_priors = false;
+  if (tables.count("images") > 0 &&
+      sqlite3_prepare_v2(database_, "PRAGMA table_info(images);", -1,
+                         &statement, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(statement) == SQLITE_ROW) {
+      const char* column =
+          reinterpret_cast<const char*>(sqlite3_column_text(statement, 1));
+      images_has_priors |= std::strcmp(column, "prior_qw") == 0;
+    }
+    sqlite3_finalize(statement);
+  }
+  if (!newer_tables.empty() ||
+      (tables.count("images") > 0 && !images_has_priors)) {
+    std::ostringstream message;
+    message
+        << "written by a newer COLMAP than 3.8 (user_version " << user_version_
+        << "; "
+        << (newer_tables.empty()
+                ? std::string("the images table has no prior_* columns")
+                : "tables " + JoinNames(newer_tables))
+        << "). rig_calibrator is built on COLMAP 3.8, which cannot read "
+           "this schema: extract the features of the map and rig images "
+           "with COLMAP 3.8 into a new database and rebuild the map from it "
+           "(see README)";
+    *error = message.str();
+    return false;
+  }
+
+  std::vector<std::string> missing;
+  for (const char* table : kColmap38Tables) {
+    if (tables.count(table) == 0) missing.push_back(table);
+  }
+  if (missing.size() == std::size(kColmap38Tables)) {
+    *error =
+        "an SQLite file but not a COLMAP database (none of the tables "
+        "cameras, images, keypoints, descriptors, matches, "
+        "two_view_geometries)";
+    return false;
+  }
+  if (!missing.empty()) {
+    *error = "not a complete COLMAP 3.8 database: missing table(s) " +
+             JoinNames(missing) +
+             (tables.count("inlier_matches") > 0
+                  ? " (it is from COLMAP older than 3.5; open a copy of it "
+                    "with COLMAP 3.8, e.g. `colmap database_creator`, to "
+                    "upgrade it)"
+                  : "");
+    return false;
+  }
+  return true;
+}
+
+bool DatabaseReader::ReadImages(std::string* error) {
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(
+          database_,
+          "SELECT image_id, name, camera_id FROM images ORDER BY image_id;", -1,
+          &statement, nullptr) != SQLITE_OK) {
+    *error = std::string("cannot read the images table: ") +
+             sqlite3_errmsg(database_);
+    return false;
+  }
+  int rc;
+  while ((rc = sqlite3_step(statement)) == SQLITE_ROW) {
+    DatabaseImage image;
+    image.image_id =
+        static_cast<colmap::image_t>(sqlite3_column_int64(statement, 0));
+    const unsigned char* name = sqlite3_column_text(statement, 1);
+    image.name = name != nullptr ? reinterpret_cast<const char*>(name) : "";
+    image.camera_id =
+        static_cast<colmap::camera_t>(sqlite3_column_int64(statement, 2));
+    image_index_by_name_[image.name] = images_.size();
+    image_index_by_id_[image.image_id] = images_.size();
+    images_.push_back(std::move(image));
+  }
+  sqlite3_finalize(statement);
+  if (rc != SQLITE_DONE) {
+    *error = std::string("cannot read the images table: ") +
+             sqlite3_errmsg(database_);
+    return false;
+  }
+  return true;
+}
+
+const DatabaseImage* DatabaseReader::FindImageWithName(
+    const std::string& name) const {
+  const auto it = image_index_by_name_.find(name);
+  return it == image_index_by_name_.end() ? nullptr : &images_[it->second];
+}
+
+const DatabaseImage* DatabaseReader::FindImageWithId(
+    const colmap::image_t image_id) const {
+  const auto it = image_index_by_id_.find(image_id);
+  return it == image_index_by_id_.end() ? nullptr : &images_[it->second];
+}
+
+bool DatabaseReader::ReadCamera(const colmap::camera_t camera_id,
+                                colmap::Camera* camera,
+                                std::string* error) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StatementScope scope(read_camera_);
+  sqlite3_bind_int64(read_camera_, 1, camera_id);
+  if (sqlite3_step(read_camera_) != SQLITE_ROW) {
+    *error = "database " + path_ + ": no camera with id " +
+             std::to_string(camera_id);
+    return false;
+  }
+  const int model_id = sqlite3_column_int(read_camera_, 0);
+  if (!colmap::ExistsCameraModelWithId(model_id)) {
+    *error = "database " + path_ + ": camera " + std::to_string(camera_id) +
+             " has model id " + std::to_string(model_id) +
+             ", which COLMAP 3.8 does not know";
+    return false;
+  }
+  const size_t num_params = colmap::CameraModelNumParams(model_id);
+  const int num_bytes = sqlite3_column_bytes(read_camera_, 3);
+  if (static_cast<size_t>(num_bytes) != num_params * sizeof(double)) {
+    *error = "database " + path_ + ": camera " + std::to_string(camera_id) +
+             " has " + std::to_string(num_bytes / sizeof(double)) +
+             " parameters, its model needs " + std::to_string(num_params);
+    return false;
+  }
+  std::vector<double> params(num_params);
+  std::memcpy(params.data(), sqlite3_column_blob(read_camera_, 3), num_bytes);
+  camera->SetCameraId(camera_id);
+  camera->SetModelId(model_id);
+  camera->SetWidth(static_cast<size_t>(sqlite3_column_int64(read_camera_, 1)));
+  camera->SetHeight(static_cast<size_t>(sqlite3_column_int64(read_camera_, 2)));
+  camera->SetParams(params);
+  camera->SetPriorFocalLength(sqlite3_column_int(read_camera_, 4) != 0);
+  return true;
+}
+
+std::string DatabaseReader::ImageLabel(const colmap::image_t image_id) const {
+  const DatabaseImage* image = FindImageWithId(image_id);
+  return "image " + (image != nullptr ? image->name + " (id " : "(id ") +
+         std::to_string(image_id) + ")";
+}
+
+int DatabaseReader::CountRows(sqlite3_stmt* statement,
+                              const colmap::image_t image_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StatementScope scope(statement);
+  sqlite3_bind_int64(statement, 1, image_id);
+  if (sqlite3_step(statement) != SQLITE_ROW) return -1;
+  return sqlite3_column_int(statement, 0);
+}
+
+int DatabaseReader::NumKeypoints(const colmap::image_t image_id) const {
+  return CountRows(count_keypoints_, image_id);
+}
+
+int DatabaseReader::NumDescriptors(const colmap::image_t image_id) const {
+  return CountRows(count_descriptors_, image_id);
+}
+
+bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
+                                   colmap::FeatureKeypoints* keypoints,
+                                   std::string* error) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StatementScope scope(read_keypoints_);
+  sqlite3_bind_int64(read_keypoints_, 1, image_id);
+  const std::string what =
+      "database " + path_ + ": keypoints of " + ImageLabel(image_id);
+  if (sqlite3_step(read_keypoints_) != SQLITE_ROW) {
+    *error = what + " are missing (run `colmap feature_extractor` on it)";
+    return false;
+  }
+  const int64_t rows = sqlite3_column_int64(read_keypoints_, 0);
+  const int64_t cols = sqlite3_column_int64(read_keypoints_, 1);
+  const int num_bytes = sqlite3_column_bytes(read_keypoints_, 2);
+  if (rows < 0 || (rows > 0 && cols != 2 && cols != 4 && cols != 6) ||
+      num_bytes != rows * cols * static_cast<int64_t>(sizeof(float))) {
+    *error = what + " are malformed (" + std::to_string(rows) + "x" +
+             std::to_string(cols) + ", " + std::to_string(num_bytes) +
+             " bytes)";
+    return false;
+  }
+  const float* data =
+      static_cast<const float*>(sqlite3_column_blob(read_keypoints_, 2));
+  keypoints->resize(rows);
+  for (int64_t i = 0; i < rows; ++i) {
+    const float* row = data + i * cols;
+    if (cols == 2) {
+      (*keypoints)[i] = colmap::FeatureKeypoint(row[0], row[1]);
+    } else if (cols == 4) {
+      (*keypoints)[i] = colmap::FeatureKeypoint(row[0], row[1], row[2], row[3]);
+    } else {
+      (*keypoints)[i] = colmap::FeatureKeypoint(row[0], row[1], row[2], row[3],
+                                                row[4], row[5]);
+    }
+  }
+  return true;
+}
+
+bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
+                                     colmap::FeatureDescriptors* descriptors,
+                                     std::string* error) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  StatementScope scope(read_descriptors_);
+  sqlite3_bind_int64(read_descriptors_, 1, image_id);
+  const std::string what =
+      "database " + path_ + ": descriptors of " + ImageLabel(image_id);
+  if (sqlite3_step(read_descriptors_) != SQLITE_ROW) {
+    *error = what + " are missing (run `colmap feature_extractor` on it)";
+    return false;
+  }
+  const int64_t rows = sqlite3_column_int64(read_descriptors_, 0);
+  const int64_t cols = sqlite3_column_int64(read_descriptors_, 1);
+  const int num_bytes = sqlite3_column_bytes(read_descriptors_, 2);
+  if (rows > 0 && cols != 128) {
+    *error = what + " have " + std::to_string(cols) +
+             " dimensions; rig_calibrator matches 128-dimensional SIFT";
+    return false;
+  }
+  if (rows < 0 || num_bytes != rows * cols) {
+    *error = what + " are malformed (" + std::to_string(rows) + "x" +
+             std::to_string(cols) + ", " + std::to_string(num_bytes) +
+             " bytes)";
+    return false;
+  }
+  descriptors->resize(rows, 128);
+  if (rows > 0) {
+    std::memcpy(descriptors->data(), sqlite3_column_blob(read_descriptors_, 2),
+                num_bytes);
+  }
+  return true;
+}
+
+bool DatabaseReader::ReadInlierMatches(const colmap::image_t image_id1,
+                                       const colmap::image_t image_id2,
+                                       colmap::FeatureMatches* matches,
+                                       std::string* error) const {
+  matches->clear();
+  std::lock_guard<std::mutex> lock(mutex_);
+  StatementScope scope(read_inlier_matches_);
+  sqlite3_bind_int64(
+      read_inlier_matches_, 1,
+      static_cast<sqlite3_int64>(ImagePairToPairId(image_id1, image_id2)));
+  if (sqlite3_step(read_inlier_matches_) != SQLITE_ROW) return true;
+  const int64_t rows = sqlite3_column_int64(read_inlier_matches_, 0);
+  const int64_t cols = sqlite3_column_int64(read_inlier_matches_, 1);
+  const int num_bytes = sqlite3_column_bytes(read_inlier_matches_, 2);
+  if (rows <= 0) return true;
+  if (cols != 2 ||
+      num_bytes != rows * cols * static_cast<int64_t>(sizeof(uint32_t))) {
+    *error = "database " + path_ + ": inlier matches of " +
+             ImageLabel(image_id1) + " and " + ImageLabel(image_id2) +
+             " are malformed";
+    return false;
+  }
+  const uint32_t* data = static_cast<const uint32_t*>(
+      sqlite3_column_blob(read_inlier_matches_, 2));
+  // COLMAP stores the columns in the order (smaller id, larger id).
+  const bool swapped = image_id1 > image_id2;
+  matches->resize(rows);
+  for (int64_t i = 0; i < rows; ++i) {
+    (*matches)[i].point2D_idx1 = data[2 * i + (swapped ? 1 : 0)];
+    (*matches)[i].point2D_idx2 = data[2 * i + (swapped ? 0 : 1)];
+  }
+  return true;
+}
+
+int64_t DatabaseReader::NumVerifiedImagePairs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  sqlite3_stmt* statement = nullptr;
+  int64_t count = 0;
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT COUNT(*) FROM two_view_geometries WHERE rows "
+                         "> 0;",
+                         -1, &statement, nullptr) == SQLITE_OK &&
+      sqlite3_step(statement) == SQLITE_ROW) {
+    count = sqlite3_column_int64(statement, 0);
+  }
+  sqlite3_finalize(statement);
+  return count;
+}
+
+uint64_t DatabaseReader::ImagePairToPairId(const colmap::image_t image_id1,
+                                           const colmap::image_t image_id2) {
+  const uint64_t min_id = std::min(image_id1, image_id2);
+  const uint64_t max_id = std::max(image_id1, image_id2);
+  return kMaxNumImages * min_id + max_id;
+}
+
+}  // namespace rig_calibrator

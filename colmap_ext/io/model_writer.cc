@@ -1,0 +1,334 @@
+#include "colmap_ext/io/model_writer.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/camchain_io.h"
+#include "colmap_ext/io/correspondence_io.h"
+#include "colmap_ext/io/rig_config_io.h"
+#include "colmap_ext/io/rig_description.h"
+
+namespace rig_calibrator {
+namespace {
+
+bool ValidIntrinsics(const colmap::Camera& camera) {
+  return camera.Width() > 0 && camera.Height() > 0 && camera.VerifyParams() &&
+         std::all_of(camera.Params().begin(), camera.Params().end(),
+                     [](double p) { return std::isfinite(p); });
+}
+
+// COLMAP's rig_configurator (>= 3.12) makes a frame of the images with the
+// same name after their camera's prefix. Framesets matched by timestamps pair
+// different names, which it would not group as this calibration did.
+int CountFramesWithDifferentKeys(const RigModel& rig_model,
+                                 const RigDescription& rig) {
+  std::unordered_map<colmap::camera_t, std::string> prefixes;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    prefixes[rig_model.rig.camera_ids[c]] = rig.cameras[c].image_prefix;
+  }
+  int count = 0;
+  for (const ModelRig::Frame& frame : rig_model.rig.frames) {
+    std::unordered_set<std::string> keys;
+    for (const colmap::image_t image_id : frame.image_ids) {
+      const colmap::Image& image = rig_model.model.Image(image_id);
+      const std::string& prefix = prefixes[image.CameraId()];
+      keys.insert(image.Name().compare(0, prefix.size(), prefix) == 0
+                      ? image.Name().substr(prefix.size())
+                      : image.Name());
+    }
+    count += keys.size() > 1 ? 1 : 0;
+  }
+  return count;
+}
+
+bool ModelFilesExist(const std::string& folder, const std::string& extension) {
+  std::error_code ignored;
+  for (const char* name : {"cameras", "images", "points3D"}) {
+    if (!std::filesystem::is_regular_file(folder + "/" + name + extension,
+                                          ignored)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Moves the map points that the final bundle adjustment refined. A run from
+// a correspondence file has no map points to move: its model has cameras and
+// images only.
+bool MoveRefinedPoints(const RigCalibration& calibration,
+                       colmap::Reconstruction* model, std::string* error) {
+  if (model->NumPoints3D() == 0) {
+    return true;
+  }
+  for (const auto& [point3D_id, xyz] : calibration.refined_points3D) {
+    if (point3D_id < 0 ||
+        !model->ExistsPoint3D(static_cast<colmap::point3D_t>(point3D_id)) ||
+        !xyz.allFinite()) {
+      *error = "the refined point " + std::to_string(point3D_id) +
+               " is not a map point or not finite";
+      return false;
+    }
+    model->Point3D(static_cast<colmap::point3D_t>(point3D_id)).SetXYZ(xyz);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
+                   const RigCalibration& calibration, RigModel* rig_model,
+                   std::string* error) {
+  if (!CheckCalibrationMatchesDataset(dataset, calibration, error)) {
+    return false;
+  }
+  const size_t num_cameras = dataset.cameras.size();
+  std::vector<colmap::Camera> cameras(num_cameras);
+  for (size_t c = 0; c < num_cameras; ++c) {
+    cameras[c] = calibration.camera_calibrated[c] ? calibration.cameras[c]
+                                                  : dataset.cameras[c].camera;
+    if (!ValidIntrinsics(cameras[c])) {
+      *error = "the camera " + dataset.cameras[c].name +
+               " has invalid intrinsics or no image size";
+      return false;
+    }
+  }
+
+  colmap::camera_t max_camera_id = 0;
+  for (const auto& [camera_id, camera] : map.Cameras()) {
+    max_camera_id = std::max(max_camera_id, camera_id);
+  }
+  colmap::image_t max_image_id = 0;
+  std::unordered_set<std::string> map_names;
+  for (const auto& [image_id, image] : map.Images()) {
+    max_image_id = std::max(max_image_id, image_id);
+    map_names.insert(image.Name());
+  }
+  // Keep clear of kInvalidCameraId/kInvalidImageId (the uint32 maximum) and
+  // leave room for the rig frame ids that follow the image ids.
+  constexpr uint64_t kMaxId = std::numeric_limits<uint32_t>::max() / 2;
+  if (max_camera_id + static_cast<uint64_t>(num_cameras) >= kMaxId ||
+      max_image_id + 2 * static_cast<uint64_t>(dataset.images.size()) >=
+          kMaxId) {
+    *error = "the map's camera or image ids are too large to add the rig";
+    return false;
+  }
+
+  rig_model->model = map;
+  colmap::Reconstruction& model = rig_model->model;
+  if (!MoveRefinedPoints(calibration, &model, error)) {
+    return false;
+  }
+
+  // The rig frame is the reference camera's frame: cam_from_ref =
+  // cam_from_rig * (ref_from_rig)^-1 and ref_from_world = ref_from_rig *
+  // rig_from_world, which leaves every cam_from_world unchanged.
+  const Rigid3d& ref_from_rig =
+      calibration.cam_from_rig[dataset.reference_camera];
+  ModelRig& rig = rig_model->rig;
+  rig = ModelRig();
+  rig.reference_camera = dataset.reference_camera;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    cameras[c].SetCameraId(max_camera_id + 1 +
+                           static_cast<colmap::camera_t>(c));
+    model.AddCamera(cameras[c]);
+    rig.camera_ids.push_back(cameras[c].CameraId());
+    if (!calibration.camera_calibrated[c]) {
+      rig.cam_from_rig.emplace_back();
+    } else if (static_cast<int>(c) == dataset.reference_camera) {
+      rig.cam_from_rig.emplace_back(Rigid3d());
+    } else {
+      rig.cam_from_rig.emplace_back(calibration.cam_from_rig[c] *
+                                    ref_from_rig.Inverse());
+    }
+  }
+
+  std::vector<int> frame_of_frameset(dataset.frameset_names.size(), -1);
+  rig_model->image_ids.assign(dataset.images.size(), colmap::kInvalidImageId);
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const RigImage& rig_image = dataset.images[i];
+    const int c = rig_image.camera_index;
+    const int f = rig_image.frameset_index;
+    if (!calibration.images[i].used || !rig.cam_from_rig[c] ||
+        !calibration.rig_from_world[f]) {
+      continue;
+    }
+    if (map_names.count(rig_image.name) > 0) {
+      *error =
+          "the rig image " + rig_image.name + " has the name of a map image";
+      return false;
+    }
+    if (frame_of_frameset[f] < 0) {
+      frame_of_frameset[f] = static_cast<int>(rig.frames.size());
+      rig.frames.push_back({ref_from_rig * *calibration.rig_from_world[f], {}});
+    }
+    ModelRig::Frame& frame = rig.frames[frame_of_frameset[f]];
+    const Rigid3d cam_from_world = *rig.cam_from_rig[c] * frame.rig_from_world;
+
+    colmap::Image image;
+    image.SetImageId(max_image_id + 1 + static_cast<colmap::image_t>(i));
+    image.SetName(rig_image.name);
+    image.SetCameraId(rig.camera_ids[c]);
+    image.SetQvec(cam_from_world.Qvec());
+    image.SetTvec(cam_from_world.translation);
+    std::vector<Eigen::Vector2d> points2D;
+    points2D.reserve(rig_image.correspondences.size());
+    for (const Correspondence& correspondence : rig_image.correspondences) {
+      points2D.push_back(correspondence.point2D);
+    }
+    image.SetPoints2D(points2D);
+    const colmap::image_t image_id = image.ImageId();
+    model.AddImage(std::move(image));
+    model.RegisterImage(image_id);
+    rig_model->image_ids[i] = image_id;
+    frame.image_ids.push_back(image_id);
+
+    const std::vector<char>& inliers = calibration.images[i].inlier_mask;
+    std::unordered_set<colmap::point3D_t> observed;
+    for (size_t k = 0; k < inliers.size(); ++k) {
+      const int64_t point3D_id = rig_image.correspondences[k].point3D_id;
+      if (!inliers[k] || point3D_id < 0) continue;
+      const colmap::point3D_t id = static_cast<colmap::point3D_t>(point3D_id);
+      if (model.ExistsPoint3D(id) && observed.insert(id).second) {
+        model.AddObservation(
+            id,
+            colmap::TrackElement(image_id, static_cast<colmap::point2D_t>(k)));
+      }
+    }
+  }
+  return true;
+}
+
+bool WriteRigOutput(const std::string& output_path,
+                    const colmap::Reconstruction& map,
+                    const RigDataset& dataset,
+                    const RigCalibration& calibration,
+                    const std::vector<std::string>& camera_prefixes,
+                    const CalibrationSummary& summary,
+                    const RigOutputOptions& options,
+                    std::vector<std::string>* notes, std::string* error) {
+  std::string output_type = options.output_type;
+  std::transform(output_type.begin(), output_type.end(), output_type.begin(),
+                 [](unsigned char c) { return std::toupper(c); });
+  if (output_type != "BIN" && output_type != "TXT") {
+    *error = "output_type must be BIN or TXT, not " + options.output_type;
+    return false;
+  }
+  const bool binary = output_type == "BIN";
+  if (!camera_prefixes.empty() &&
+      camera_prefixes.size() != dataset.cameras.size()) {
+    *error = "one camera prefix per camera is needed";
+    return false;
+  }
+
+  // Everything that can fail for reasons other than the file system is done
+  // before the output folder is touched.
+  RigModel rig_model;
+  if (!BuildRigModel(map, dataset, calibration, &rig_model, error)) {
+    return false;
+  }
+  ColmapRigsAndFrames rigs_frames;
+  if (!BuildRigsAndFrames(rig_model.model, rig_model.rig, &rigs_frames,
+                          error)) {
+    return false;
+  }
+  RigDescription rig =
+      DescribeCalibratedRig(dataset, calibration, camera_prefixes);
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    if (rig.cameras[c].camera) {
+      rig.cameras[c].camera->SetCameraId(rig_model.rig.camera_ids[c]);
+    }
+  }
+
+  std::vector<std::string> new_notes;
+  const bool reference_calibrated =
+      rig.cameras[rig.reference_camera].camera.has_value();
+  if (reference_calibrated) {
+    const RigBundleAdjusterGrouping grouping =
+        PredictRigBundleAdjusterGrouping(rig, rig_model.model);
+    int num_multi_image_frames = 0;
+    for (const ModelRig::Frame& frame : rig_model.rig.frames) {
+      num_multi_image_frames += frame.image_ids.size() > 1 ? 1 : 0;
+    }
+    if (grouping.num_multi_image_snapshots != num_multi_image_frames ||
+        !grouping.problems.empty()) {
+      new_notes.push_back(
+          std::string(kRigBundleAdjusterConfigFile) +
+          ": COLMAP 3.8 rig_bundle_adjuster groups images by name and will "
+          "see " +
+          std::to_string(grouping.num_multi_image_snapshots) +
+          " snapshots with two images or more, where this calibration has " +
+          std::to_string(num_multi_image_frames) + " such framesets");
+    }
+    for (const std::string& problem : grouping.problems) {
+      new_notes.push_back(
+          std::string(kRigBundleAdjusterConfigFile) +
+          ": COLMAP 3.8 rig_bundle_adjuster would abort: " + problem);
+    }
+  } else {
+    new_notes.push_back(std::string(kRigBundleAdjusterConfigFile) +
+                        " is not written: the reference camera is not "
+                        "calibrated");
+  }
+  const int num_renamed_frames = CountFramesWithDifferentKeys(rig_model, rig);
+  if (num_renamed_frames > 0) {
+    new_notes.push_back(
+        std::string(kRigConfigFile) + ": " +
+        std::to_string(num_renamed_frames) +
+        " framesets pair images with different names after the camera "
+        "prefix (timestamp matching); COLMAP's rig_configurator groups frames "
+        "by identical names and will not find them (frames.* hold them)");
+  }
+
+  auto write_contents = [&](const std::string& folder, std::string* error) {
+    if (binary) {
+      rig_model.model.WriteBinary(folder);
+    } else {
+      rig_model.model.WriteText(folder);
+    }
+    if (!ModelFilesExist(folder, binary ? ".bin" : ".txt")) {
+      *error = "cannot write the COLMAP model into " + folder;
+      return false;
+    }
+    if (!WriteRigsAndFrames(folder, rigs_frames, binary, error) ||
+        !WriteRigConfigJson(folder + "/" + kRigConfigFile, rig, error)) {
+      return false;
+    }
+    if (reference_calibrated &&
+        !WriteRigBundleAdjusterConfig(
+            folder + "/" + kRigBundleAdjusterConfigFile, rig, error)) {
+      return false;
+    }
+    std::string camchain_error;
+    if (!WriteCamchainYaml(folder + "/" + kCamchainFile, rig, &new_notes,
+                           &camchain_error)) {
+      new_notes.push_back(std::string(kCamchainFile) +
+                          " is not written: " + camchain_error);
+    }
+    CalibrationSummary final_summary = summary;
+    final_summary.diagnostics.insert(final_summary.diagnostics.end(),
+                                     new_notes.begin(), new_notes.end());
+    return WriteCalibrationSummaryJson(folder + "/" + kSummaryFile,
+                                       final_summary, error) &&
+           WriteCorrespondenceFile(folder + "/" + kCorrespondencesFile,
+                                   DatasetCorrespondences(dataset), error);
+  };
+  OutputFolderOptions folder_options;
+  folder_options.overwrite = options.overwrite;
+  folder_options.input_paths = options.input_paths;
+  if (!WriteFolderAtomically(output_path, folder_options, write_contents,
+                             error)) {
+    return false;
+  }
+  if (notes != nullptr) {
+    notes->insert(notes->end(), new_notes.begin(), new_notes.end());
+  }
+  return true;
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,190 @@
+// Localization of rig images against a COLMAP map (pipeline step 1): for
+// every rig image, 2D-3D correspondences between its keypoints and the map's
+// 3D points, deduplicated (one map point per keypoint, one keypoint per map
+// point). Poses are estimated later, by the radial RANSAC.
+//
+// Sources of correspondences, per image:
+//  * database matches: the inlier matches COLMAP's matchers stored in
+//    `two_view_geometries` between the rig image and registered map images
+//    (used when they exist and `use_database_matches` is on);
+//  * `direct` mode (default): each feature is looked up in a FLANN index of
+//    the map points' track descriptors (PointDescriptorIndex), built once per
+//    map, with COLMAP's ratio test against the second-best map point;
+//  * `retrieval` mode: SIFT matching (COLMAP's MatchSiftFeaturesCPU) against
+//    the top map images, chosen by the vocabulary tree when one is given,
+//    else all map images for a small map, else the map images that see most
+//    of the image's direct matches.
+// Everything is read from the database; nothing is ever written to it.
+//
+// Why direct is the default (measured with the disabled benchmark in
+// tests/colmap_ext/localization/map_localizer_test.cc, map of 300 images x 2000 features,
+// rig images of 2000 features): direct costs 0.26 CPU s per image (index of
+// 360k descriptors built in ~3 s), i.e. ~7.5 images/s on 2 cores; retrieval
+// with 10 map images costs 1.85 CPU s per image. These are with 128 FLANN
+// checks; the default 64 (`index.num_checks`) halves the direct cost.
+#pragma once
+
+#include <colmap/base/reconstruction.h>
+#include <colmap/feature/sift.h>
+#include <colmap/feature/types.h>
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "colmap_ext/io/database_reader.h"
+#include "colmap_ext/localization/point_descriptor_index.h"
+#include "src/calibration/rig_dataset.h"
+
+namespace rig_calibrator {
+
+enum class LocalizationMode { kDirect, kRetrieval };
+
+// "direct" / "retrieval"; false for anything else.
+bool LocalizationModeFromName(const std::string& name, LocalizationMode* mode);
+std::string LocalizationModeName(LocalizationMode mode);
+
+struct MapLocalizerOptions {
+  MapLocalizerOptions();
+
+  LocalizationMode mode = LocalizationMode::kDirect;
+
+  // COLMAP's SiftMatching.* options. `max_ratio` (0.8) and `max_distance`
+  // (0.7 rad) apply to both modes; retrieval mode passes all of them to
+  // MatchSiftFeaturesCPU (`use_gpu` is always false).
+  colmap::SiftMatchingOptions sift_matching;
+
+  // Direct mode: descriptors kept per map point (chosen by
+  // SelectRepresentativeDescriptors) and the FLANN search parameters.
+  int max_descriptors_per_point = 4;
+  PointDescriptorIndex::Options index;
+
+  // Retrieval mode: a COLMAP 3.8 (FLANN) vocabulary tree; without it, all map
+  // images when there are at most `max_num_map_images_exhaustive`, else the
+  // `num_retrieved_images` map images that see most direct matches.
+  std::string vocab_tree_path;
+  int num_retrieved_images = 10;
+  int max_num_map_images_exhaustive = 50;
+
+  // Use the inlier matches stored in the database between a rig image and
+  // registered map images, when the image has any.
+  bool use_database_matches = true;
+
+  // -1: all cores.
+  int num_threads = -1;
+  // Log a progress line every this many images (0: never).
+  int progress_interval = 50;
+
+  bool Check(std::string* error) const;
+};
+
+enum class CorrespondenceSource {
+  kNone,             // no correspondence found
+  kDatabaseMatches,  // two_view_geometries inlier matches
+  kDirectIndex,      // PointDescriptorIndex
+  kImageMatching,    // MatchSiftFeaturesCPU against retrieved map images
+};
+std::string CorrespondenceSourceName(CorrespondenceSource source);
+
+struct ImageLocalization {
+  std::string image_name;
+  colmap::image_t image_id = colmap::kInvalidImageId;     // in the database
+  colmap::camera_t camera_id = colmap::kInvalidCameraId;  // in the database
+  // Deduplicated; point3D_id is the map's point id.
+  std::vector<Correspondence> correspondences;
+  // The keypoint index of every correspondence.
+  std::vector<colmap::point2D_t> point2D_idxs;
+  CorrespondenceSource source = CorrespondenceSource::kNone;
+  int num_candidates = 0;          // 2D-3D matches before deduplication
+  int num_map_images_matched = 0;  // retrieval / database matches
+  double seconds = 0;
+};
+
+// One candidate 2D-3D match. `votes` counts the map images (or index hits)
+// that support it; `angle` is its SIFT descriptor distance (radians).
+struct CorrespondenceCandidate {
+  colmap::point2D_t point2D_idx = colmap::kInvalidPoint2DIdx;
+  colmap::point3D_t point3D_id = colmap::kInvalidPoint3DId;
+  int votes = 1;
+  float angle = 0;
+};
+
+// A one-to-one subset of the candidates: candidates of the same
+// (keypoint, point) pair are merged (votes summed, smallest angle kept), then
+// pairs are accepted greedily from the best (most votes, then smallest angle,
+// then smallest keypoint and point ids) while neither their keypoint nor their
+// point is taken.
+std::vector<CorrespondenceCandidate> SelectOneToOneCorrespondences(
+    std::vector<CorrespondenceCandidate> candidates);
+
+class MapLocalizer {
+ public:
+  // Reads, for every registered map image, the descriptors of its keypoints
+  // that have a 3D point, and builds the indices the options need. The map
+  // images must be in the database under their model names, with as many
+  // keypoints as the model has points2D. `database` must outlive the
+  // localizer. nullptr and *error on failure.
+  static std::unique_ptr<MapLocalizer> Create(
+      const MapLocalizerOptions& options, const colmap::Reconstruction& map,
+      const DatabaseReader* database, std::string* error);
+  ~MapLocalizer();
+
+  // Localizes one database image by name.
+  bool Localize(const std::string& image_name, ImageLocalization* result,
+                std::string* error) const;
+
+  // Localizes the images in parallel (options.num_threads), logging progress;
+  // results in the order of `image_names`. Fails before any work if a name is
+  // not in the database or has no features.
+  bool LocalizeImages(const std::vector<std::string>& image_names,
+                      std::vector<ImageLocalization>* results,
+                      std::string* error) const;
+
+  size_t NumMapImages() const { return map_image_ids_.size(); }
+  size_t NumMapPoints() const { return map_points_.size(); }
+  size_t NumIndexedDescriptors() const { return point_index_.NumDescriptors(); }
+
+ private:
+  class VocabTree;
+  struct MapPoint {
+    Eigen::Vector3d xyz;
+    std::vector<colmap::image_t> image_ids;  // database ids of its track
+  };
+
+  MapLocalizer(const MapLocalizerOptions& options,
+               const DatabaseReader* database);
+  bool ReadMap(const colmap::Reconstruction& map, std::string* error);
+  bool BuildVocabTree(std::string* error);
+  bool CheckImageFeatures(const DatabaseImage& image, std::string* error) const;
+  bool LocalizeImage(const DatabaseImage& image, ImageLocalization* result,
+                     std::string* error) const;
+  bool CollectDatabaseMatches(const DatabaseImage& image,
+                              const colmap::FeatureDescriptors& descriptors,
+                              std::vector<CorrespondenceCandidate>* candidates,
+                              int* num_map_images_matched,
+                              std::string* error) const;
+  std::vector<colmap::image_t> SelectMapImages(
+      const colmap::FeatureKeypoints& keypoints,
+      const colmap::FeatureDescriptors& descriptors) const;
+  bool MatchMapImages(const std::vector<colmap::image_t>& map_image_ids,
+                      const colmap::FeatureDescriptors& descriptors,
+                      std::vector<CorrespondenceCandidate>* candidates,
+                      int* num_map_images_matched, std::string* error) const;
+  int NumThreads() const;
+
+  MapLocalizerOptions options_;
+  const DatabaseReader* database_;
+  // Registered map images (database ids), sorted, and per image the map
+  // point of every keypoint (kInvalidPoint3DId: none).
+  std::vector<colmap::image_t> map_image_ids_;
+  std::unordered_map<colmap::image_t, std::vector<colmap::point3D_t>>
+      map_image_point3D_ids_;
+  std::unordered_map<colmap::point3D_t, MapPoint> map_points_;
+  PointDescriptorIndex point_index_;
+  std::unique_ptr<VocabTree> vocab_tree_;
+  // Whether two_view_geometries holds any verified pair at all.
+  bool has_database_matches_ = false;
+};
+
+}  // namespace rig_calibrator

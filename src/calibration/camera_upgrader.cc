@@ -1,0 +1,592 @@
+#include "src/calibration/camera_upgrader.h"
+
+#include <ceres/ceres.h>
+#include <colmap/base/camera_models.h>
+#include <colmap/optim/loransac.h>
+#include <colmap/optim/sampler.h>
+#include <colmap/util/threading.h>
+#include <glog/logging.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "src/solvers/intrinsics_solvers.h"
+
+namespace rig_calibrator {
+namespace {
+
+// LM runs, each followed by a re-evaluation of the inliers on all points.
+constexpr int kMaxNumRefinementRounds = 3;
+// Below this reciprocal condition number of the equilibrated J^T J the
+// covariance is treated as singular.
+constexpr double kMinReciprocalCondition = 1e-14;
+
+// The radial profile and number of radial terms of a model's initialization.
+struct Initialization {
+  RadialProfile profile = RadialProfile::kPolynomial;
+  int num_radial_terms = 0;
+};
+
+bool InitializationForModel(const int model_id, Initialization* init) {
+  switch (model_id) {
+    case colmap::SimplePinholeCameraModel::kModelId:
+    case colmap::PinholeCameraModel::kModelId:
+      *init = {RadialProfile::kPolynomial, 0};
+      return true;
+    case colmap::SimpleRadialCameraModel::kModelId:
+      *init = {RadialProfile::kPolynomial, 1};
+      return true;
+    case colmap::RadialCameraModel::kModelId:
+    case colmap::OpenCVCameraModel::kModelId:
+    case colmap::FullOpenCVCameraModel::kModelId:
+      *init = {RadialProfile::kPolynomial, 2};
+      return true;
+    case colmap::SimpleRadialFisheyeCameraModel::kModelId:
+      *init = {RadialProfile::kEquidistant, 1};
+      return true;
+    case colmap::RadialFisheyeCameraModel::kModelId:
+    case colmap::OpenCVFisheyeCameraModel::kModelId:
+    case colmap::ThinPrismFisheyeCameraModel::kModelId:
+      *init = {RadialProfile::kEquidistant, 2};
+      return true;
+    default:
+      return false;
+  }
+}
+
+// colmap::RandomSampler draws from COLMAP's thread-local generator, whose
+// state depends on whatever ran before on the thread (the pipeline upgrades
+// cameras on a thread pool). This one has its own generator with a fixed
+// seed, so the upgrade depends only on its input.
+class SeededRandomSampler : public colmap::Sampler {
+ public:
+  explicit SeededRandomSampler(const size_t num_samples)
+      : num_samples_(num_samples) {}
+
+  void Initialize(const size_t total_num_samples) override {
+    CHECK_LE(num_samples_, total_num_samples);
+    indices_.resize(total_num_samples);
+    std::iota(indices_.begin(), indices_.end(), 0);
+  }
+
+  size_t MaxNumSamples() override { return std::numeric_limits<size_t>::max(); }
+
+  // Partial Fisher-Yates shuffle: the first num_samples_ indices.
+  std::vector<size_t> Sample() override {
+    for (size_t i = 0; i < num_samples_; ++i) {
+      std::uniform_int_distribution<size_t> distribution(i,
+                                                         indices_.size() - 1);
+      std::swap(indices_[i], indices_[distribution(generator_)]);
+    }
+    return {indices_.begin(), indices_.begin() + num_samples_};
+  }
+
+ private:
+  const size_t num_samples_;
+  std::vector<size_t> indices_;
+  std::mt19937 generator_{0};
+};
+
+template <int kNumRadialTerms>
+bool RunInitializationRansac(const colmap::RANSACOptions& ransac_options,
+                             const RadialProfile profile,
+                             const std::vector<Eigen::Vector2d>& x,
+                             const std::vector<Eigen::Vector3d>& points_cam,
+                             RadialIntrinsics* model) {
+  using Estimator = RadialIntrinsicsEstimator<kNumRadialTerms>;
+  colmap::LORANSAC<Estimator, Estimator, colmap::InlierSupportMeasurer,
+                   SeededRandomSampler>
+      ransac(ransac_options);
+  ransac.estimator.profile = profile;
+  ransac.local_estimator.profile = profile;
+  const auto report = ransac.Estimate(x, points_cam);
+  if (!report.success) {
+    return false;
+  }
+  *model = report.model;
+  return true;
+}
+
+bool EstimateInitialIntrinsics(const colmap::RANSACOptions& ransac_options,
+                               const Initialization& init,
+                               const std::vector<Eigen::Vector2d>& x,
+                               const std::vector<Eigen::Vector3d>& points_cam,
+                               RadialIntrinsics* model) {
+  switch (init.num_radial_terms) {
+    case 0:
+      return RunInitializationRansac<0>(ransac_options, init.profile, x,
+                                        points_cam, model);
+    case 1:
+      return RunInitializationRansac<1>(ransac_options, init.profile, x,
+                                        points_cam, model);
+    default:
+      return RunInitializationRansac<2>(ransac_options, init.profile, x,
+                                        points_cam, model);
+  }
+}
+
+// Full reprojection residual of one correspondence:
+//   WorldToImage(params, a / (c + tz), b / (c + tz)) - observed pixel,
+// with COLMAP's templated camera model. Points on or behind the camera plane
+// (c + tz <= 0) cannot be projected: the evaluation fails, so the LM rejects
+// steps that would move an inlier behind the camera.
+template <typename CameraModel>
+class FullReprojectionCost {
+ public:
+  FullReprojectionCost(const Eigen::Vector2d& point2D,
+                       const Eigen::Vector3d& point_cam)
+      : point2D_(point2D), point_cam_(point_cam) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
+                                     const Eigen::Vector3d& point_cam) {
+    return new ceres::AutoDiffCostFunction<FullReprojectionCost, 2, 1,
+                                           CameraModel::kNumParams>(
+        new FullReprojectionCost(point2D, point_cam));
+  }
+
+  template <typename T>
+  bool operator()(const T* const tz, const T* const params,
+                  T* residuals) const {
+    const T depth = T(point_cam_.z()) + tz[0];
+    if (!(depth > T(0))) {
+      return false;
+    }
+    T x, y;
+    CameraModel::WorldToImage(params, T(point_cam_.x()) / depth,
+                              T(point_cam_.y()) / depth, &x, &y);
+    residuals[0] = x - T(point2D_.x());
+    residuals[1] = y - T(point2D_.y());
+    return true;
+  }
+
+ private:
+  const Eigen::Vector2d point2D_;
+  const Eigen::Vector3d point_cam_;
+};
+
+// Entries of C = (J^T J)^-1 (variances at 1 px noise); see
+// CameraUpgradeResult.
+struct Conditioning {
+  bool singular = true;
+  double tz_focal_correlation = 1;
+  double tz_variance = 0;
+  double focal_variance = 0;
+};
+
+// The covariance C = (J^T J)^-1 over tz and the refined (tangent) parameters,
+// from the robustified Jacobian of every residual block of the problem.
+Conditioning ComputeConditioning(const ceres::Problem& problem,
+                                 const std::vector<ceres::ResidualBlockId>& ids,
+                                 const std::vector<int>& focal_tangent_idxs,
+                                 const int num_tangent_params) {
+  const int n = 1 + num_tangent_params;
+  Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(n, n);
+  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> J(2, n);
+  Eigen::Matrix<double, 2, 1> J_tz;
+  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> J_params(
+      2, num_tangent_params);
+  double* jacobians[2] = {J_tz.data(), J_params.data()};
+  double residuals[2];
+  double cost = 0;
+  for (const ceres::ResidualBlockId id : ids) {
+    if (!problem.EvaluateResidualBlock(id, /*apply_loss_function=*/true, &cost,
+                                       residuals, jacobians)) {
+      continue;
+    }
+    J << J_tz, J_params;
+    JtJ.noalias() += J.transpose() * J;
+  }
+
+  Conditioning conditioning;
+  // Correlations do not depend on the units of the parameters: equilibrate
+  // J^T J so that the singularity test does not either.
+  const Eigen::VectorXd diagonal = JtJ.diagonal();
+  if (!JtJ.allFinite() || (diagonal.array() <= 0).any()) {
+    return conditioning;
+  }
+  const Eigen::VectorXd scales = diagonal.cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd normalized =
+      scales.asDiagonal() * JtJ * scales.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(normalized);
+  const Eigen::VectorXd& eigenvalues = eigen.eigenvalues();
+  if (eigen.info() != Eigen::Success ||
+      !(eigenvalues(0) > kMinReciprocalCondition * eigenvalues(n - 1))) {
+    return conditioning;
+  }
+  const Eigen::MatrixXd covariance =
+      scales.asDiagonal() *
+      (eigen.eigenvectors() * eigenvalues.cwiseInverse().asDiagonal() *
+       eigen.eigenvectors().transpose()) *
+      scales.asDiagonal();
+  // f = mean of the focal lengths: var(f) = mean of their covariances,
+  // cov(tz, f) = mean of their covariances with tz.
+  double tz_focal_covariance = 0;
+  double focal_variance = 0;
+  for (const int i : focal_tangent_idxs) {
+    tz_focal_covariance += covariance(0, 1 + i);
+    for (const int j : focal_tangent_idxs) {
+      focal_variance += covariance(1 + i, 1 + j);
+    }
+  }
+  const double num_focals = focal_tangent_idxs.size();
+  tz_focal_covariance /= num_focals;
+  focal_variance /= num_focals * num_focals;
+  conditioning.singular = false;
+  conditioning.tz_variance = covariance(0, 0);
+  conditioning.focal_variance = focal_variance;
+  conditioning.tz_focal_correlation =
+      tz_focal_covariance / std::sqrt(covariance(0, 0) * focal_variance);
+  return conditioning;
+}
+
+// Marks the points whose full reprojection error is below the threshold and
+// that the model projects on the side of the principal point given by the
+// radial pose, (x - c).(a, b) >= 0 (a distortion whose radial factor turns
+// negative mirrors points through the principal point); returns their
+// number.
+template <typename CameraModel>
+int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
+                    const std::vector<Eigen::Vector3d>& points_cam,
+                    const std::vector<char>& valid, const double tz,
+                    const std::vector<double>& params,
+                    const double max_error_px, std::vector<char>* inlier_mask,
+                    double* rms_px) {
+  const double max_squared_error = max_error_px * max_error_px;
+  const Eigen::Vector2d principal_point(
+      params[CameraModel::principal_point_idxs[0]],
+      params[CameraModel::principal_point_idxs[1]]);
+  inlier_mask->assign(points2D.size(), 0);
+  int num_inliers = 0;
+  double sum_squared_error = 0;
+  for (size_t i = 0; i < points2D.size(); ++i) {
+    const double depth = points_cam[i].z() + tz;
+    if (!valid[i] || !(depth > 0)) {
+      continue;
+    }
+    Eigen::Vector2d projection;
+    CameraModel::WorldToImage(params.data(), points_cam[i].x() / depth,
+                              points_cam[i].y() / depth, &projection.x(),
+                              &projection.y());
+    const double squared_error = (projection - points2D[i]).squaredNorm();
+    if (squared_error <= max_squared_error &&
+        (projection - principal_point).dot(points_cam[i].head<2>()) >= 0) {
+      (*inlier_mask)[i] = 1;
+      ++num_inliers;
+      sum_squared_error += squared_error;
+    }
+  }
+  *rms_px = num_inliers > 0 ? std::sqrt(sum_squared_error / num_inliers) : 0;
+  return num_inliers;
+}
+
+// Step 3: LM over tz and the model's parameters on the inliers, inliers
+// re-evaluated on all points, repeated while they change.
+template <typename CameraModel>
+bool RefineUpgrade(const CameraUpgradeOptions& options,
+                   const std::vector<Eigen::Vector2d>& points2D,
+                   const std::vector<Eigen::Vector3d>& points_cam,
+                   const std::vector<char>& valid, double* tz,
+                   std::vector<double>* params, CameraUpgradeResult* result) {
+  const std::vector<size_t>& focal_idxs = CameraModel::focal_length_idxs;
+  const std::vector<size_t>& principal_point_idxs =
+      CameraModel::principal_point_idxs;
+  std::vector<int> tangent_idxs;  // parameter index -> tangent index or -1
+  int num_tangent_params = 0;
+  for (size_t i = 0; i < CameraModel::kNumParams; ++i) {
+    const bool fixed = !options.refine_principal_point &&
+                       std::count(principal_point_idxs.begin(),
+                                  principal_point_idxs.end(), i) > 0;
+    tangent_idxs.push_back(fixed ? -1 : num_tangent_params++);
+  }
+  std::vector<int> focal_tangent_idxs;
+  for (const size_t i : focal_idxs) {
+    focal_tangent_idxs.push_back(tangent_idxs[i]);
+  }
+  const int num_unknowns = 1 + num_tangent_params;
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.num_threads =
+      colmap::GetEffectiveNumThreads(options.num_threads);
+  // Noisy data stop on the cost (Ceres' default function tolerance); exact
+  // data, whose cost keeps falling by orders of magnitude, on the step.
+  solver_options.parameter_tolerance = 1e-12;
+  solver_options.logging_type = ceres::SILENT;
+
+  std::vector<char>& inlier_mask = result->inlier_mask;
+  std::vector<double> refined_params = *params;
+  double refined_tz = *tz;
+  for (int round = 0; round < kMaxNumRefinementRounds; ++round) {
+    const int num_inliers =
+        std::count(inlier_mask.begin(), inlier_mask.end(), 1);
+    if (num_inliers < num_unknowns) {
+      result->error_message = "only " + std::to_string(num_inliers) +
+                              " inliers for " + std::to_string(num_unknowns) +
+                              " unknowns";
+      return false;
+    }
+    ceres::Problem problem;
+    problem.AddParameterBlock(&refined_tz, 1);
+    problem.AddParameterBlock(refined_params.data(), CameraModel::kNumParams);
+    if (!options.refine_principal_point) {
+      problem.SetManifold(refined_params.data(),
+                          new ceres::SubsetManifold(
+                              CameraModel::kNumParams,
+                              std::vector<int>(principal_point_idxs.begin(),
+                                               principal_point_idxs.end())));
+    }
+    ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
+    std::vector<ceres::ResidualBlockId> residual_blocks;
+    residual_blocks.reserve(num_inliers);
+    for (size_t i = 0; i < points2D.size(); ++i) {
+      if (inlier_mask[i]) {
+        residual_blocks.push_back(
+            problem.AddResidualBlock(FullReprojectionCost<CameraModel>::Create(
+                                         points2D[i], points_cam[i]),
+                                     loss, &refined_tz, refined_params.data()));
+      }
+    }
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    if (!summary.IsSolutionUsable() || !std::isfinite(refined_tz) ||
+        !std::all_of(refined_params.begin(), refined_params.end(),
+                     [](double p) { return std::isfinite(p); })) {
+      result->error_message = "the refinement failed: " + summary.message;
+      return false;
+    }
+
+    const std::vector<char> previous_mask = inlier_mask;
+    result->num_inliers = EvaluateInliers<CameraModel>(
+        points2D, points_cam, valid, refined_tz, refined_params,
+        options.max_error_px, &inlier_mask, &result->rms_px);
+    if (inlier_mask == previous_mask || round + 1 == kMaxNumRefinementRounds) {
+      const Conditioning conditioning = ComputeConditioning(
+          problem, residual_blocks, focal_tangent_idxs, num_tangent_params);
+      double mean_focal = 0;
+      for (const size_t i : focal_idxs) {
+        mean_focal += refined_params[i] / focal_idxs.size();
+      }
+      std::vector<double> depths;
+      for (size_t i = 0; i < points_cam.size(); ++i) {
+        if (inlier_mask[i]) depths.push_back(points_cam[i].z() + refined_tz);
+      }
+      std::nth_element(depths.begin(), depths.begin() + depths.size() / 2,
+                       depths.end());
+      const double median_depth =
+          depths.empty() ? 0 : depths[depths.size() / 2];
+      result->tz_focal_correlation = conditioning.tz_focal_correlation;
+      result->tz_stddev_at_1px = std::sqrt(conditioning.tz_variance);
+      result->focal_stddev_at_1px = std::sqrt(conditioning.focal_variance);
+      result->well_conditioned =
+          !conditioning.singular &&
+          result->focal_stddev_at_1px <= kMaxRelativeStddevAt1px * mean_focal &&
+          result->tz_stddev_at_1px <= kMaxRelativeStddevAt1px * median_depth;
+      break;
+    }
+  }
+  for (const size_t i : focal_idxs) {
+    if (!(refined_params[i] > 0)) {
+      result->error_message =
+          "the refinement produced a non-positive focal "
+          "length";
+      return false;
+    }
+  }
+  if (result->num_inliers < num_unknowns) {
+    result->error_message = "only " + std::to_string(result->num_inliers) +
+                            " inliers after the refinement";
+    return false;
+  }
+  *tz = refined_tz;
+  *params = refined_params;
+  return true;
+}
+
+bool RefineUpgradeForModel(const int model_id,
+                           const CameraUpgradeOptions& options,
+                           const std::vector<Eigen::Vector2d>& points2D,
+                           const std::vector<Eigen::Vector3d>& points_cam,
+                           const std::vector<char>& valid, double* tz,
+                           std::vector<double>* params,
+                           CameraUpgradeResult* result) {
+  switch (model_id) {
+#define RIG_CALIBRATOR_REFINE_CASE(CameraModel)                              \
+  case colmap::CameraModel::kModelId:                                        \
+    return RefineUpgrade<colmap::CameraModel>(options, points2D, points_cam, \
+                                              valid, tz, params, result);
+    RIG_CALIBRATOR_REFINE_CASE(SimplePinholeCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(PinholeCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(SimpleRadialCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(RadialCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(OpenCVCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(FullOpenCVCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(SimpleRadialFisheyeCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(RadialFisheyeCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(OpenCVFisheyeCameraModel)
+    RIG_CALIBRATOR_REFINE_CASE(ThinPrismFisheyeCameraModel)
+#undef RIG_CALIBRATOR_REFINE_CASE
+    default:
+      result->error_message = "unsupported camera model";
+      return false;
+  }
+}
+
+std::string CheckOptions(const CameraUpgradeOptions& options) {
+  if (!(options.max_error_px > 0)) return "max_error_px must be > 0";
+  if (!(options.confidence > 0 && options.confidence < 1)) {
+    return "confidence must be in (0, 1)";
+  }
+  if (options.min_num_trials < 0 ||
+      options.max_num_trials < options.min_num_trials) {
+    return "need 0 <= min_num_trials <= max_num_trials";
+  }
+  if (options.max_num_ransac_points < 1) {
+    return "max_num_ransac_points must be >= 1";
+  }
+  if (!(options.loss_scale_px > 0)) return "loss_scale_px must be > 0";
+  if (options.max_num_iterations < 1) return "max_num_iterations must be >= 1";
+  return "";
+}
+
+bool Fail(const std::string& message, CameraUpgradeResult* result) {
+  result->error_message = message;
+  LOG(ERROR) << "Camera upgrade: " << message;
+  return false;
+}
+
+}  // namespace
+
+bool IsUpgradeSupportedCameraModel(const int model_id) {
+  Initialization init;
+  return InitializationForModel(model_id, &init);
+}
+
+bool UpgradeCamera(const CameraUpgradeOptions& options,
+                   const std::vector<Eigen::Vector2d>& points2D,
+                   const std::vector<Eigen::Vector3d>& points_cam,
+                   colmap::Camera* camera, CameraUpgradeResult* result) {
+  if (camera == nullptr || result == nullptr) {
+    LOG(ERROR) << "Camera upgrade: null camera or result";
+    return false;
+  }
+  *result = CameraUpgradeResult();
+  const std::string options_error = CheckOptions(options);
+  if (!options_error.empty()) {
+    return Fail("invalid options: " + options_error, result);
+  }
+  if (points2D.size() != points_cam.size()) {
+    return Fail(std::to_string(points2D.size()) + " 2D points but " +
+                    std::to_string(points_cam.size()) + " 3D points",
+                result);
+  }
+  Initialization init;
+  if (!InitializationForModel(camera->ModelId(), &init)) {
+    const std::string name = colmap::CameraModelIdToName(camera->ModelId());
+    return Fail(
+        "camera model " +
+            (name.empty() ? "id " + std::to_string(camera->ModelId()) : name) +
+            " is not supported (supported: SIMPLE_PINHOLE, PINHOLE, "
+            "SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, "
+            "SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE, OPENCV_FISHEYE, "
+            "THIN_PRISM_FISHEYE)",
+        result);
+  }
+  if (!camera->VerifyParams()) {
+    return Fail(
+        "camera has " + std::to_string(camera->NumParams()) +
+            " parameters, model " + camera->ModelName() + " needs " +
+            std::to_string(colmap::CameraModelNumParams(camera->ModelId())),
+        result);
+  }
+  const Eigen::Vector2d principal_point(camera->PrincipalPointX(),
+                                        camera->PrincipalPointY());
+  if (!principal_point.allFinite()) {
+    return Fail("the principal point is not finite", result);
+  }
+
+  // Valid correspondences, with pixels relative to the principal point.
+  const size_t num_points = points2D.size();
+  std::vector<char> valid(num_points, 0);
+  std::vector<size_t> valid_idxs;
+  for (size_t i = 0; i < num_points; ++i) {
+    if (points2D[i].allFinite() && points_cam[i].allFinite()) {
+      valid[i] = 1;
+      valid_idxs.push_back(i);
+    }
+  }
+  const size_t min_num_points = init.num_radial_terms + 3;
+  if (valid_idxs.size() < min_num_points) {
+    return Fail(std::to_string(valid_idxs.size()) +
+                    " valid correspondences, need at least " +
+                    std::to_string(min_num_points),
+                result);
+  }
+
+  // Step 1 on at most max_num_ransac_points of them, drawn with a fixed seed.
+  std::vector<size_t> ransac_idxs = valid_idxs;
+  if (ransac_idxs.size() > static_cast<size_t>(options.max_num_ransac_points)) {
+    std::mt19937 generator(0);
+    std::shuffle(ransac_idxs.begin(), ransac_idxs.end(), generator);
+    ransac_idxs.resize(options.max_num_ransac_points);
+  }
+  std::vector<Eigen::Vector2d> ransac_x;
+  std::vector<Eigen::Vector3d> ransac_points_cam;
+  for (const size_t i : ransac_idxs) {
+    ransac_x.push_back(points2D[i] - principal_point);
+    ransac_points_cam.push_back(points_cam[i]);
+  }
+  colmap::RANSACOptions ransac_options;
+  ransac_options.max_error = options.max_error_px;
+  ransac_options.confidence = options.confidence;
+  ransac_options.min_num_trials = options.min_num_trials;
+  ransac_options.max_num_trials = options.max_num_trials;
+  RadialIntrinsics initial;
+  if (!EstimateInitialIntrinsics(ransac_options, init, ransac_x,
+                                 ransac_points_cam, &initial)) {
+    return Fail("no initial tz and focal length consistent with " +
+                    std::to_string(init.num_radial_terms + 3) +
+                    " or more of the " + std::to_string(ransac_idxs.size()) +
+                    " correspondences",
+                result);
+  }
+  result->inlier_mask.assign(num_points, 0);
+  const double max_squared_error = options.max_error_px * options.max_error_px;
+  for (const size_t i : valid_idxs) {
+    Eigen::Vector2d projection;
+    result->inlier_mask[i] =
+        initial.Project(points_cam[i], &projection) &&
+        (projection + principal_point - points2D[i]).squaredNorm() <=
+            max_squared_error;
+  }
+
+  // Step 2: the model's parameters from the initialization.
+  std::vector<double> params(camera->NumParams(), 0.0);
+  for (const size_t i : camera->FocalLengthIdxs()) {
+    params[i] = initial.focal;
+  }
+  params[camera->PrincipalPointIdxs()[0]] = principal_point.x();
+  params[camera->PrincipalPointIdxs()[1]] = principal_point.y();
+  for (int j = 0; j < init.num_radial_terms; ++j) {
+    params[camera->ExtraParamsIdxs()[j]] = initial.k[j];
+  }
+
+  // Step 3.
+  double tz = initial.tz;
+  if (!RefineUpgradeForModel(camera->ModelId(), options, points2D, points_cam,
+                             valid, &tz, &params, result)) {
+    result->tz = 0;
+    result->num_inliers = 0;
+    result->inlier_mask.assign(num_points, 0);
+    return Fail(result->error_message, result);
+  }
+  result->tz = tz;
+  camera->SetParams(params);
+  return true;
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,111 @@
+// Final bundle adjustment of the rig calibration (paper §3.6, pipeline step 6):
+// all intrinsics, every camera's cam_from_rig and every frameset's
+// rig_from_world are refined together on the full reprojection error
+//
+//   min  sum_{i,j,p} rho(|pi_theta_i(P_i Q_j X_p) - x_ijp|^2),
+//
+// theta_i the COLMAP camera model parameters of camera i, P_i its
+// cam_from_rig, Q_j the rig_from_world of frameset j, X_p a map point, rho the
+// Cauchy loss. Map points are held fixed unless asked (they fix the world
+// frame and scale); the reference camera's cam_from_rig stays the identity
+// (it defines the rig frame). After a first solve, outliers are pruned
+// relative to each camera's robust residual spread and the problem is solved
+// again.
+//
+// Speed: each frameset's rig pose is seen only through the few shared
+// camera blocks, so the rig poses are the eliminated group of the Schur
+// complement and the reduced system (intrinsics and extrinsics of the rig
+// cameras) is tiny; the cost is residual and Jacobian evaluation, which Ceres
+// spreads over all threads.
+#pragma once
+
+#include <string>
+
+#include "src/calibration/rig_dataset.h"
+
+namespace ceres {
+class CostFunction;
+}  // namespace ceres
+
+namespace rig_calibrator {
+
+struct FinalBundleAdjustmentOptions {
+  double loss_scale_px = 1.0;  // Cauchy loss scale
+  int max_num_iterations = 100;
+  bool refine_focal_length = true;  // false for the `known` method
+  bool refine_principal_point = true;
+  bool refine_extra_params = true;  // distortion
+  // cam_from_rig of the non-reference cameras (the reference camera is held
+  // at the identity).
+  bool refine_extrinsics = true;
+  bool refine_rig_poses = true;  // rig_from_world
+  // Map points (by point3D_id). Only points with an id that are observed at
+  // least twice are refined: a point seen once has 3 unknowns for 2
+  // residuals, and points with id -1 are a separate point per observation.
+  // When no fixed point remains to anchor the world frame, the result is
+  // moved back onto the map by the similarity that best aligns the refined
+  // points with their map positions (the reprojection errors do not change).
+  bool refine_points = false;
+  // Outlier pruning after a first solve, then solve again. An observation is
+  // an outlier if
+  //  - its reprojection error exceeds max(min_outlier_error_px,
+  //    outlier_sigma_factor * sigma_i), sigma_i = 1.4826 * MAD of the x and y
+  //    residual components of its camera i (the robust standard deviation of
+  //    one component; for Gaussian noise |e| > 4 sigma has probability
+  //    exp(-8)). The sigma is per camera so that a fisheye camera, whose
+  //    periphery has larger but consistent errors, keeps its periphery while a
+  //    pinhole camera of the same rig is pruned at its own tighter level;
+  //  - or its point is behind the camera;
+  //  - or its depth exceeds max_depth_factor * the median depth of all
+  //    observations (scene-scale relative: no map units are hard-coded).
+  // The last two tests also run before the first solve, so that no residual
+  // is ever evaluated behind a camera.
+  double min_outlier_error_px = 2.0;
+  double outlier_sigma_factor = 4.0;
+  double max_depth_factor = 50.0;
+  // Prune-and-resolve rounds after the first solve; stops early when a round
+  // prunes nothing. 0: no pruning.
+  int num_pruning_rounds = 2;
+  int num_threads = -1;         // Ceres threads (-1: all cores)
+  bool print_progress = false;  // Ceres per-iteration progress
+};
+
+struct FinalBundleAdjustmentSummary {
+  // RMS of the reprojection error over the observations of the first solve
+  // at the initial estimate, and over the final inliers at the result.
+  double initial_rms_px = 0, final_rms_px = 0;
+  // Observations (2-vector residual blocks) in the last solve; observations
+  // given as inliers and rejected (pruned, behind a camera, too far); Ceres
+  // iterations summed over all solves; wall time of AdjustRig.
+  int num_residuals = 0, num_outliers = 0, num_iterations = 0;
+  double seconds = 0;
+  std::string ceres_report;  // Ceres BriefReport of the last solve
+};
+
+// Minimizes the objective above over the correspondences with
+// calibration->images[i].inlier_mask set, of the images whose frameset has a
+// rig pose and whose camera is calibrated. Updates calibration->cameras,
+// cam_from_rig, rig_from_world, images[i].inlier_mask / num_inliers / rms_px /
+// used (images outside the adjustment get an all-zero mask and used = false)
+// and, with refine_points, refined_points3D. On bad input (inconsistent
+// sizes, unknown camera model, no usable observation) or a Ceres failure it
+// logs the reason, leaves `calibration` unchanged and returns false.
+// `summary` may be null.
+bool AdjustRig(const FinalBundleAdjustmentOptions& options,
+               const RigDataset& dataset, RigCalibration* calibration,
+               FinalBundleAdjustmentSummary* summary);
+
+// The cost of one observation, for Ceres: residual pi_theta(P Q X) - x in
+// pixels (2). Parameter blocks: rig_from_world Q and cam_from_rig P as
+// [qw, qx, qy, qz, tx, ty, tz] (for ceres::QuaternionManifold times R^3), the
+// camera's COLMAP parameters theta and, when `point3D` is null, the point X
+// (3); a given `point3D` is held fixed. Jacobians are analytic for the poses
+// and the point, forward-mode (ceres::Jet) through the templated COLMAP
+// camera model. Evaluation fails (returns false) for a point that is not in
+// front of the camera. Null for an unknown camera model id. The caller owns
+// the result.
+ceres::CostFunction* CreateRigReprojectionError(int model_id,
+                                                const Eigen::Vector2d& observed,
+                                                const Eigen::Vector3d* point3D);
+
+}  // namespace rig_calibrator

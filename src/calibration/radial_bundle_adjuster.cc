@@ -1,0 +1,404 @@
+#include "src/calibration/radial_bundle_adjuster.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <colmap/util/threading.h>
+#include <glog/logging.h>
+
+#include <Eigen/Eigenvalues>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "src/geometry/radial_cost_functions.h"
+#include "src/calibration/rig_initializer.h"
+
+namespace rig_calibrator {
+namespace {
+
+// An image with fewer inliers says little about its frameset's rig pose.
+constexpr int kMinInliersPerImage = 5;
+// After the first solve, an image whose correspondences are mostly beyond
+// max_radial_error_px is taken as mis-localized and dropped whole.
+constexpr double kMinInlierShare = 0.5;
+
+// One correspondence in the adjustment.
+struct Observation {
+  int image;  // dataset image index
+  int camera;
+  int frameset;
+  Eigen::Vector2d point2D;
+  Eigen::Vector3d point3D;
+};
+
+// The adjusted quantities, as Ceres parameter blocks.
+struct Parameters {
+  std::vector<std::array<double, 6>> cam_from_rig;
+  std::vector<std::array<double, 6>> rig_from_world;
+  std::vector<std::array<double, 2>> principal_points;
+};
+
+// |pi_r(...) - (x - c)|: the radial reprojection error of an observation.
+double RadialError(const Observation& observation,
+                   const Parameters& parameters) {
+  const double* blocks[] = {
+      parameters.cam_from_rig[observation.camera].data(),
+      parameters.rig_from_world[observation.frameset].data(),
+      parameters.principal_points[observation.camera].data()};
+  double residual[2];
+  RadialRigCostFunction(observation.point2D, observation.point3D)
+      .Evaluate(blocks, residual, nullptr);
+  return std::hypot(residual[0], residual[1]);
+}
+
+double RmsRadialError(const std::vector<Observation>& observations,
+                      const Parameters& parameters) {
+  if (observations.empty()) return 0;
+  double sum_sq = 0;
+  for (const Observation& observation : observations) {
+    const double error = RadialError(observation, parameters);
+    sum_sq += error * error;
+  }
+  return std::sqrt(sum_sq / observations.size());
+}
+
+// The observations of the framesets whose rig pose they determine. With
+// radial projections a rig pose's translation is determined iff
+// sum_k (I - z_k z_k^T) over the principal axes z_k (in the rig frame) of
+// the cameras observing it is regular; only cameras with
+// kMinInliersPerImage observations in the frameset count.
+std::vector<Observation> KeepDeterminedFramesets(
+    const std::vector<Observation>& observations,
+    const RigCalibration& calibration, double min_axis_eigenvalue) {
+  const int num_framesets = calibration.rig_from_world.size();
+  std::vector<std::vector<int>> count_of_camera(
+      num_framesets, std::vector<int>(calibration.cam_from_rig.size(), 0));
+  for (const Observation& observation : observations) {
+    ++count_of_camera[observation.frameset][observation.camera];
+  }
+  std::vector<char> determined(num_framesets, 0);
+  for (int j = 0; j < num_framesets; ++j) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    int num_cameras = 0;
+    for (size_t i = 0; i < count_of_camera[j].size(); ++i) {
+      if (count_of_camera[j][i] < kMinInliersPerImage) continue;
+      const Eigen::Vector3d axis =
+          calibration.cam_from_rig[i].RotationMatrix().row(2).transpose();
+      normal += Eigen::Matrix3d::Identity() - axis * axis.transpose();
+      ++num_cameras;
+    }
+    determined[j] =
+        num_cameras >= 2 && Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                normal, Eigen::EigenvaluesOnly)
+                                    .eigenvalues()(0) >= min_axis_eigenvalue;
+  }
+  std::vector<Observation> kept;
+  for (const Observation& observation : observations) {
+    if (determined[observation.frameset]) kept.push_back(observation);
+  }
+  return kept;
+}
+
+// One Levenberg-Marquardt solve over the observations. Gauge: the reference
+// camera's pose is constant, every camera's tz is held, and so is the t_z of
+// one rig pose (the rig origin's slide along the reference axis moves every
+// rig pose's t_z; holding one removes that null direction). Rig poses form
+// the eliminated group of the Schur complement: no residual links two.
+ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
+                             const std::vector<Observation>& observations,
+                             int reference_camera, Parameters* parameters) {
+  const int num_cameras = parameters->cam_from_rig.size();
+  const int num_framesets = parameters->rig_from_world.size();
+  ceres::Problem problem;
+  ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
+  std::vector<char> cam_added(num_cameras, 0);
+  std::vector<char> rig_added(num_framesets, 0);
+  for (const Observation& observation : observations) {
+    problem.AddResidualBlock(
+        new RadialRigCostFunction(observation.point2D, observation.point3D),
+        loss, parameters->cam_from_rig[observation.camera].data(),
+        parameters->rig_from_world[observation.frameset].data(),
+        parameters->principal_points[observation.camera].data());
+    cam_added[observation.camera] = 1;
+    rig_added[observation.frameset] = 1;
+  }
+
+  auto* ordering = new ceres::ParameterBlockOrdering;
+  bool tz_gauge_held = false;
+  for (int j = 0; j < num_framesets; ++j) {
+    if (!rig_added[j]) continue;
+    ordering->AddElementToGroup(parameters->rig_from_world[j].data(), 0);
+    if (!tz_gauge_held) {
+      problem.SetManifold(parameters->rig_from_world[j].data(),
+                          new ceres::SubsetManifold(6, {5}));
+      tz_gauge_held = true;
+    }
+  }
+  for (int i = 0; i < num_cameras; ++i) {
+    if (!cam_added[i]) continue;
+    ordering->AddElementToGroup(parameters->cam_from_rig[i].data(), 1);
+    ordering->AddElementToGroup(parameters->principal_points[i].data(), 1);
+    if (i == reference_camera) {
+      problem.SetParameterBlockConstant(parameters->cam_from_rig[i].data());
+    } else {
+      problem.SetManifold(parameters->cam_from_rig[i].data(),
+                          new ceres::SubsetManifold(6, {5}));
+    }
+    if (!options.refine_principal_points) {
+      problem.SetParameterBlockConstant(parameters->principal_points[i].data());
+    }
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering.reset(ordering);
+  solver_options.max_num_iterations = options.max_num_iterations;
+  // Noisy problems stop on the relative cost change (Ceres' default 1e-6);
+  // this lets exact ones converge to the last digits of map-unit poses.
+  solver_options.parameter_tolerance = 1e-10;
+  solver_options.num_threads =
+      colmap::GetEffectiveNumThreads(options.num_threads);
+  solver_options.minimizer_progress_to_stdout = options.print_progress;
+  solver_options.logging_type =
+      options.print_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(solver_options, &problem, &solver_summary);
+  return solver_summary;
+}
+
+bool ObservesReference(const std::vector<Observation>& observations,
+                       int reference_camera) {
+  for (const Observation& observation : observations) {
+    if (observation.camera == reference_camera) return true;
+  }
+  return false;
+}
+
+bool Fail(const std::string& message, RadialBundleAdjustmentSummary* summary) {
+  LOG(ERROR) << "AdjustRadialRig: " << message;
+  if (summary) summary->message = message;
+  return false;
+}
+
+// Sizes and indices the adjustment relies on; an error message, empty if
+// the input is consistent.
+std::string CheckInput(const RigDataset& dataset,
+                       const RigCalibration& calibration) {
+  const size_t num_cameras = dataset.cameras.size();
+  std::ostringstream error;
+  if (num_cameras == 0) return "the dataset has no cameras";
+  if (calibration.cameras.size() != num_cameras ||
+      calibration.cam_from_rig.size() != num_cameras ||
+      calibration.camera_calibrated.size() != num_cameras ||
+      calibration.rig_from_world.size() != dataset.frameset_names.size() ||
+      calibration.images.size() != dataset.images.size()) {
+    error << "calibration sizes (" << calibration.cameras.size() << " cameras, "
+          << calibration.cam_from_rig.size() << " cam_from_rig, "
+          << calibration.camera_calibrated.size() << " calibrated flags, "
+          << calibration.rig_from_world.size() << " rig poses, "
+          << calibration.images.size() << " images) do not match the dataset ("
+          << num_cameras << " cameras, " << dataset.frameset_names.size()
+          << " framesets, " << dataset.images.size() << " images)";
+    return error.str();
+  }
+  if (dataset.reference_camera < 0 ||
+      dataset.reference_camera >= static_cast<int>(num_cameras)) {
+    error << "reference camera index " << dataset.reference_camera
+          << " is out of range";
+    return error.str();
+  }
+  if (!calibration.camera_calibrated[dataset.reference_camera]) {
+    return "the reference camera " +
+           dataset.cameras[dataset.reference_camera].name +
+           " is not calibrated";
+  }
+  for (size_t i = 0; i < num_cameras; ++i) {
+    if (!calibration.cameras[i].VerifyParams()) {
+      return "camera " + dataset.cameras[i].name +
+             " has no valid model parameters";
+    }
+  }
+  for (size_t k = 0; k < dataset.images.size(); ++k) {
+    const RigImage& image = dataset.images[k];
+    if (image.camera_index < 0 ||
+        image.camera_index >= static_cast<int>(num_cameras) ||
+        image.frameset_index < 0 ||
+        image.frameset_index >=
+            static_cast<int>(dataset.frameset_names.size())) {
+      error << "image " << image.name << " has camera index "
+            << image.camera_index << " and frameset index "
+            << image.frameset_index << ", out of range";
+      return error.str();
+    }
+    const std::vector<char>& mask = calibration.images[k].inlier_mask;
+    if (!mask.empty() && mask.size() != image.correspondences.size()) {
+      error << "image " << image.name << " has an inlier mask of size "
+            << mask.size() << " for " << image.correspondences.size()
+            << " correspondences";
+      return error.str();
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
+                     const RigDataset& dataset, RigCalibration* calibration,
+                     RadialBundleAdjustmentSummary* summary) {
+  const auto start_time = std::chrono::steady_clock::now();
+  if (summary) *summary = RadialBundleAdjustmentSummary();
+  if (calibration == nullptr) return Fail("no calibration given", summary);
+  const std::string error = CheckInput(dataset, *calibration);
+  if (!error.empty()) return Fail(error, summary);
+  if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0 ||
+      !(options.max_radial_error_px >= 0)) {
+    return Fail(
+        "loss_scale_px must be positive, max_num_iterations and "
+        "max_radial_error_px non-negative",
+        summary);
+  }
+  const int num_cameras = dataset.cameras.size();
+  const int num_framesets = dataset.frameset_names.size();
+  const int reference = dataset.reference_camera;
+  const double min_axis_eigenvalue =
+      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
+
+  // Inlier correspondences of images of calibrated cameras in posed
+  // framesets that their observations determine.
+  std::vector<Observation> candidates;
+  for (size_t k = 0; k < dataset.images.size(); ++k) {
+    const RigImage& image = dataset.images[k];
+    const std::vector<char>& mask = calibration->images[k].inlier_mask;
+    if (!calibration->camera_calibrated[image.camera_index] ||
+        !calibration->rig_from_world[image.frameset_index]) {
+      continue;
+    }
+    for (size_t c = 0; c < mask.size(); ++c) {
+      if (mask[c]) {
+        candidates.push_back({static_cast<int>(k), image.camera_index,
+                              image.frameset_index,
+                              image.correspondences[c].point2D,
+                              image.correspondences[c].point3D});
+      }
+    }
+  }
+  std::vector<Observation> observations =
+      KeepDeterminedFramesets(candidates, *calibration, min_axis_eigenvalue);
+  const std::string no_reference_message =
+      "the reference camera " + dataset.cameras[reference].name +
+      " has no inlier correspondences in framesets with a determined rig pose";
+  if (!ObservesReference(observations, reference)) {
+    return Fail(no_reference_message, summary);
+  }
+
+  Parameters parameters;
+  parameters.cam_from_rig.resize(num_cameras);
+  parameters.principal_points.resize(num_cameras);
+  for (int i = 0; i < num_cameras; ++i) {
+    parameters.cam_from_rig[i] =
+        ToAngleAxisTranslation(calibration->cam_from_rig[i]);
+    parameters.principal_points[i] = {
+        calibration->cameras[i].PrincipalPointX(),
+        calibration->cameras[i].PrincipalPointY()};
+  }
+  parameters.rig_from_world.resize(num_framesets);
+  for (int j = 0; j < num_framesets; ++j) {
+    if (calibration->rig_from_world[j]) {
+      parameters.rig_from_world[j] =
+          ToAngleAxisTranslation(*calibration->rig_from_world[j]);
+    }
+  }
+  const double initial_rms = RmsRadialError(observations, parameters);
+
+  // The Cauchy loss bounds the pull of each wrong correspondence, but the
+  // correspondences of a mis-localized image agree with one another, and a
+  // principal point shift is nearly a pan/tilt of the camera, a weakly
+  // constrained direction in which small coherent pulls add up. So after a
+  // first solve, the images with fewer than kMinInlierShare of their
+  // correspondences within max_radial_error_px are dropped whole (a few of a
+  // wrong image's points always fall near the predicted lines), the
+  // remaining correspondences beyond it too, and the rest solved again.
+  ceres::Solver::Summary solver_summary =
+      Solve(options, observations, reference, &parameters);
+  int num_iterations = solver_summary.iterations.size();
+  int num_outliers = 0;
+  if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
+    std::vector<char> within(observations.size(), 0);
+    std::vector<int> num_selected(dataset.images.size(), 0);
+    std::vector<int> num_within(dataset.images.size(), 0);
+    for (size_t n = 0; n < observations.size(); ++n) {
+      within[n] = RadialError(observations[n], parameters) <=
+                  options.max_radial_error_px;
+      ++num_selected[observations[n].image];
+      num_within[observations[n].image] += within[n];
+    }
+    std::vector<Observation> inliers;
+    for (size_t n = 0; n < observations.size(); ++n) {
+      const int image = observations[n].image;
+      if (within[n] &&
+          num_within[image] >= kMinInlierShare * num_selected[image]) {
+        inliers.push_back(observations[n]);
+      }
+    }
+    num_outliers = observations.size() - inliers.size();
+    if (num_outliers > 0) {
+      observations =
+          KeepDeterminedFramesets(inliers, *calibration, min_axis_eigenvalue);
+      if (!ObservesReference(observations, reference)) {
+        return Fail(no_reference_message + " after removing outliers", summary);
+      }
+      solver_summary = Solve(options, observations, reference, &parameters);
+      num_iterations += solver_summary.iterations.size();
+    }
+  }
+  if (!solver_summary.IsSolutionUsable()) {
+    return Fail("the solver failed: " + solver_summary.message, summary);
+  }
+
+  // Write back what the final solve adjusted.
+  std::vector<char> cam_adjusted(num_cameras, 0);
+  std::vector<char> rig_adjusted(num_framesets, 0);
+  for (const Observation& observation : observations) {
+    cam_adjusted[observation.camera] = 1;
+    rig_adjusted[observation.frameset] = 1;
+  }
+  for (int i = 0; i < num_cameras; ++i) {
+    if (!cam_adjusted[i]) continue;
+    calibration->cam_from_rig[i] =
+        FromAngleAxisTranslation(parameters.cam_from_rig[i]);
+    calibration->cam_from_rig[i].translation.z() = 0;
+    calibration->cameras[i].SetPrincipalPointX(
+        parameters.principal_points[i][0]);
+    calibration->cameras[i].SetPrincipalPointY(
+        parameters.principal_points[i][1]);
+  }
+  calibration->cam_from_rig[reference] = Rigid3d();
+  int num_skipped = 0;
+  for (int j = 0; j < num_framesets; ++j) {
+    if (rig_adjusted[j]) {
+      calibration->rig_from_world[j] =
+          FromAngleAxisTranslation(parameters.rig_from_world[j]);
+    } else if (calibration->rig_from_world[j]) {
+      ++num_skipped;
+    }
+  }
+  NormalizeRadialRigOrigin(reference, calibration);
+
+  if (summary) {
+    summary->initial_rms_px = initial_rms;
+    summary->final_rms_px = RmsRadialError(observations, parameters);
+    summary->num_residuals = observations.size();
+    summary->num_outliers = num_outliers;
+    summary->num_iterations = num_iterations;
+    summary->num_framesets_skipped = num_skipped;
+    summary->seconds = std::chrono::duration<double>(
+                           std::chrono::steady_clock::now() - start_time)
+                           .count();
+  }
+  return true;
+}
+
+}  // namespace rig_calibrator

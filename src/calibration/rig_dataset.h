@@ -1,0 +1,83 @@
+// The calibration problem and its solution, independent of where the data
+// came from (a COLMAP database, a correspondence file or the synthetic
+// generator). Cameras use COLMAP's camera models and parameter orders; pixel
+// coordinates follow COLMAP (the center of the top-left pixel is (0.5, 0.5)).
+#pragma once
+
+#include <colmap/base/camera.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "src/geometry/rigid3d.h"
+
+namespace rig_calibrator {
+
+// One 2D-3D correspondence: a keypoint of a rig image and a map point.
+struct Correspondence {
+  Eigen::Vector2d point2D = Eigen::Vector2d::Zero();  // pixels
+  Eigen::Vector3d point3D = Eigen::Vector3d::Zero();  // map coordinates
+  int64_t point3D_id = -1;                            // -1: not a map point id
+};
+
+// One image of one rig camera in one frameset.
+struct RigImage {
+  std::string name;  // database/model name, e.g. "cam0/000012.png"
+  int camera_index = -1;
+  int frameset_index = -1;
+  std::vector<Correspondence> correspondences;
+};
+
+// One camera of the rig. `camera` carries the model, the image size and the
+// parameters: initial values (principal point at the image center) or, with
+// `intrinsics_known`, the given intrinsics (the `known*` methods).
+struct RigCamera {
+  std::string name;  // the folder, e.g. "cam0"
+  colmap::Camera camera;
+  bool intrinsics_known = false;
+};
+
+struct RigDataset {
+  std::vector<RigCamera> cameras;
+  std::vector<std::string> frameset_names;  // one per frameset
+  std::vector<RigImage> images;
+  int reference_camera = 0;  // its cam_from_rig is the identity
+};
+
+// What became of one image.
+struct ImageResult {
+  bool localized = false;  // a radial (or full) pose was found on its own
+  bool used = false;       // part of the final calibration
+  std::vector<char> inlier_mask;  // per correspondence, after the final BA
+  int num_inliers = 0;
+  double radial_rms_px = 0;  // radial reprojection RMS over inliers
+  double rms_px = 0;         // full reprojection RMS over inliers
+  std::optional<Rigid3d> single_image_cam_from_world;  // its own estimate
+};
+
+struct RigCalibration {
+  std::vector<colmap::Camera> cameras;  // calibrated intrinsics, per camera
+  std::vector<Rigid3d> cam_from_rig;    // per camera
+  std::vector<bool> camera_calibrated;  // false: the camera could not be fitted
+  std::vector<std::optional<Rigid3d>> rig_from_world;  // per frameset
+  std::vector<ImageResult> images;                     // per dataset image
+  // Map points moved by a final bundle adjustment that refines points, by
+  // point3D_id; empty when the map is held fixed (the default).
+  std::unordered_map<int64_t, Eigen::Vector3d> refined_points3D;
+
+  Rigid3d CamFromWorld(int camera_index, int frameset_index) const {
+    return cam_from_rig[camera_index] * *rig_from_world[frameset_index];
+  }
+};
+
+// The one check of a calibration problem, whatever its source: at least two
+// cameras, a valid reference camera, every camera with an image size and
+// parameters valid for its model, every image with a valid camera and
+// frameset, and finite correspondences. Returns false with `error` naming the
+// camera or image and what is wrong.
+bool ValidateDataset(const RigDataset& dataset, std::string* error);
+
+}  // namespace rig_calibrator

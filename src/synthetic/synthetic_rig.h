@@ -1,0 +1,117 @@
+// Synthetic rig calibration problems with a known answer, for tests and
+// benchmarks: a rig preset (true intrinsics and camera-from-rig poses), a
+// smooth trajectory of rig poses, and per image 2D-3D correspondences made by
+// projecting map points with COLMAP's camera models, with Gaussian pixel
+// noise, wrong matches (outliers) and missing images.
+//
+// Frames: the world is z-up. Each preset places its cameras in a "body" frame
+// (x forward, y left, z up; for the car, the origin is on the ground below the
+// car's center); the rig frame is camera 0's frame (cam_from_rig[0] is the
+// identity), as everywhere in the project.
+#pragma once
+
+#include <colmap/base/camera.h>
+
+#include <string>
+#include <vector>
+
+#include "src/calibration/rig_dataset.h"
+#include "src/geometry/rigid3d.h"
+
+namespace rig_calibrator {
+
+enum class RigPreset { kRing5, kFisheyeHelmet5, kCarSurround4, kStereoPair };
+
+// Parses/prints "ring5", "fisheye_helmet5", "car_surround4", "stereo_pair".
+bool RigPresetFromName(const std::string& name, RigPreset* preset);
+std::string RigPresetName(RigPreset preset);
+std::vector<RigPreset> AllRigPresets();
+
+struct RigGroundTruth {
+  std::vector<colmap::Camera> cameras;    // true intrinsics
+  std::vector<Rigid3d> cam_from_rig;      // camera 0 (the reference) = identity
+  std::vector<Rigid3d> rig_from_world;    // per frameset
+  std::vector<std::string> camera_names;  // "cam0", ...
+};
+
+// The true cameras and extrinsics of a preset (rig_from_world is empty):
+//  ring5: 5 outward-looking OPENCV 640x480 cameras at 72 degree steps on a
+//    0.15 m ring, f 405-445 px, k1 ~ -0.3, k2 ~ 0.08, small p1, p2, principal
+//    points up to 20 px off-center, pitched by a few degrees.
+//  fisheye_helmet5: 5 OPENCV_FISHEYE 640x480 cameras with a 145-155 degree
+//    diagonal field of view on a 0.12 m helmet ring, pitched 10-15 degrees
+//    up or down.
+//  car_surround4: on a 4.5 x 1.8 m car, front OPENCV 960x600 (0.6 m high,
+//    12 degrees down), left and right mirror OPENCV_FISHEYE 800x600 with a
+//    160 degree diagonal field of view (1.0 m, 28-30 degrees down), back
+//    RADIAL 640x480 (1.1 m, 20 degrees down).
+//  stereo_pair: EuRoC-like forward-looking OPENCV 752x480 pair, 0.11 m
+//    baseline, axes parallel up to a 0.2 degree misalignment.
+RigGroundTruth MakeRigPreset(RigPreset preset);
+
+struct SyntheticRigOptions {
+  RigPreset preset = RigPreset::kRing5;
+  int num_framesets = 30;
+  int points_per_image = 300;
+  // Standard deviation of the Gaussian noise on each pixel coordinate.
+  double noise_px = 0.5;
+  // Share of each image's correspondences whose 3D point is replaced by
+  // another map point that projects more than 20 px away (wrong matches).
+  double outlier_ratio = 0.3;
+  // Share of all images dropped (no image at all); no frameset is emptied.
+  double missing_image_ratio = 0.1;
+  // Range of the distance of an image's map points from its camera center.
+  double min_depth = 2.0, max_depth = 10.0;
+  // Share of the correct correspondences placed on a dominant plane (the
+  // ground, z = 0) when the ground is seen within the depth range; the others
+  // fall back to free-space points.
+  double near_planar_ratio = 0.0;
+  // Share of the correct correspondences that re-observe map points created
+  // by images of the previous framesets (feature tracks, shared point3D_id),
+  // as far as such points are visible; the rest are new map points.
+  double track_ratio = 0.5;
+  // Side of the window, as a share of the image width and height, that holds
+  // an image's correspondences; the window is placed at random per image
+  // (1: the whole image). Small windows model images whose features cluster
+  // on one textured region, leaving the image's own intrinsics poorly
+  // determined while all images of a camera together still cover it.
+  double feature_window = 1.0;
+  // ring5 only: the number of cameras on the ring (0: the preset's 5; at
+  // most 36), evenly spaced on its 0.15 m circle, looking outwards. Camera i
+  // has the model, size, distortion, pitch, roll and height of ring5's camera
+  // i mod 5 and its focal lengths scaled by 1 + 0.03 * floor(i / 5). E.g. 10
+  // for a 10-camera rig (runtime benchmark).
+  int ring_num_cameras = 0;
+  unsigned int seed = 0;
+
+  // False (with a message) for values outside their ranges.
+  bool Check(std::string* error) const;
+};
+
+struct SyntheticRig {
+  // Cameras: same model and size as the truth, parameters = initial guesses
+  // (COLMAP's defaults: focal 1.2 * max(width, height), principal point at the
+  // image center, zero distortion); names cam0, cam1, ...; images
+  // "camK/000012.png"; frameset names "000012".
+  RigDataset dataset;
+  RigGroundTruth truth;
+  // Per dataset image, per correspondence: 1 for a wrong match.
+  std::vector<std::vector<char>> is_outlier;
+};
+
+// Deterministic for a seed. With invalid options, logs the error and returns a
+// rig without images.
+SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options);
+
+// The sub-problem made of the given framesets (indices into rig, in the given
+// order, renumbered from 0; names kept), e.g. for the short-sequence
+// robustness experiments (paper section 5.3: 10 framesets). Indices out of
+// range or repeated are logged and skipped.
+SyntheticRig SelectFramesets(const SyntheticRig& rig,
+                             const std::vector<int>& framesets);
+
+// Gives every dataset camera its true intrinsics, flagged as known (the
+// `known*` methods).
+void SetKnownIntrinsics(SyntheticRig* rig);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,156 @@
+#include "colmap_ext/benchmarks/runtime_benchmark.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace rig_calibrator {
+namespace {
+
+CalibrationRuntime MakeRun(int num_framesets, int num_cameras,
+                           double cpu_seconds) {
+  CalibrationRuntime run;
+  run.num_framesets = num_framesets;
+  run.num_cameras = num_cameras;
+  run.num_images = num_framesets * num_cameras;
+  run.num_correspondences = 300L * run.num_images;
+  run.generation_seconds = 0.25;
+  run.stages = {{"Single-image localization", 0.5, 0.9},
+                {"Final bundle adjustment", cpu_seconds / 3, cpu_seconds / 2}};
+  run.seconds = cpu_seconds / 1.5;
+  run.cpu_seconds = cpu_seconds;
+  run.peak_memory_mb = 123.4;
+  run.success = true;
+  run.final_rms_px = 0.705;
+  run.max_rotation_error_deg = 0.02;
+  run.max_center_error_m = 0.0005;
+  return run;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream stream(text);
+  std::string line;
+  while (std::getline(stream, line)) lines.push_back(line);
+  return lines;
+}
+
+TEST(RuntimeBenchmark, CalibrationRuntimeRoundTrips) {
+  CalibrationRuntime run = MakeRun(500, 10, 41.5);
+  run.success = false;
+  run.error = "the radial rig initialization failed:\nno seed";
+  CalibrationRuntime parsed;
+  std::string error;
+  ASSERT_TRUE(ParseCalibrationRuntime(SerializeCalibrationRuntime(run), &parsed,
+                                      &error))
+      << error;
+  EXPECT_EQ(parsed.num_framesets, 500);
+  EXPECT_EQ(parsed.num_cameras, 10);
+  EXPECT_EQ(parsed.num_images, 5000);
+  EXPECT_EQ(parsed.num_correspondences, 1500000);
+  EXPECT_DOUBLE_EQ(parsed.cpu_seconds, 41.5);
+  EXPECT_NEAR(parsed.seconds, 41.5 / 1.5, 1e-8);
+  EXPECT_FALSE(parsed.success);
+  // The message stays on one line.
+  EXPECT_EQ(parsed.error, "the radial rig initialization failed: no seed");
+  ASSERT_EQ(parsed.stages.size(), 2u);
+  EXPECT_EQ(parsed.stages[1].stage, "Final bundle adjustment");
+  EXPECT_NEAR(parsed.stages[1].cpu_seconds, 41.5 / 2, 1e-8);
+
+  EXPECT_FALSE(ParseCalibrationRuntime("something else\n", &parsed, &error));
+  EXPECT_NE(error.find("header"), std::string::npos);
+  std::string text = SerializeCalibrationRuntime(run);
+  text.replace(text.find("cpu_seconds 41.5"), 16, "cpu_seconds x");
+  EXPECT_FALSE(ParseCalibrationRuntime(text, &parsed, &error));
+  EXPECT_NE(error.find("cpu_seconds"), std::string::npos);
+}
+
+TEST(RuntimeBenchmark, LocalizationRuntimeRoundTrips) {
+  LocalizationRuntime run;
+  run.mode = "direct";
+  run.num_map_images = 300;
+  run.num_map_points = 90000;
+  run.num_indexed_descriptors = 360000;
+  run.features_per_rig_image = 2000;
+  run.num_checks = 64;
+  run.num_images = 40;
+  run.index_seconds = 3.5;
+  run.seconds = 5;
+  run.cpu_seconds = 9.5;
+  run.recall = 0.97;
+  run.precision = 0.99;
+  run.radial_pose_seconds_per_image = 0.002;
+  run.num_poses_correct = 39;
+  LocalizationRuntime parsed;
+  std::string error;
+  ASSERT_TRUE(ParseLocalizationRuntime(SerializeLocalizationRuntime(run),
+                                       &parsed, &error))
+      << error;
+  EXPECT_EQ(parsed.mode, "direct");
+  EXPECT_EQ(parsed.num_indexed_descriptors, 360000);
+  EXPECT_EQ(parsed.num_poses_correct, 39);
+  EXPECT_EQ(parsed.num_checks, 64);
+  EXPECT_DOUBLE_EQ(parsed.ImagesPerSecond(), 8.0);
+  EXPECT_FALSE(ParseLocalizationRuntime(
+      SerializeCalibrationRuntime(MakeRun(10, 5, 1)), &parsed, &error));
+}
+
+TEST(RuntimeBenchmark, CsvHasOneColumnPairPerStageAndOneRowPerRun) {
+  std::vector<CalibrationRuntime> runs = {MakeRun(10, 5, 1.0),
+                                          MakeRun(50, 5, 5.0)};
+  // A fallback run has an extra stage: a column for it, empty elsewhere.
+  runs[1].stages.push_back({"Rig initialization", 0.125, 0.25});
+  const std::vector<std::string> lines = Lines(CalibrationRuntimeCsv(runs));
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].rfind("framesets,cameras,images,correspondences,success,"
+                           "\"Single-image localization wall s\"",
+                           0),
+            0u);
+  EXPECT_NE(lines[0].find("\"Rig initialization CPU s\""), std::string::npos);
+  const auto count_commas = [](const std::string& line) {
+    return std::count(line.begin(), line.end(), ',');
+  };
+  EXPECT_EQ(count_commas(lines[1]), count_commas(lines[0]));
+  EXPECT_EQ(count_commas(lines[2]), count_commas(lines[0]));
+  EXPECT_EQ(lines[1].rfind("10,5,50,15000,1,0.500,0.900,", 0), 0u);
+  EXPECT_NE(lines[1].find(",,,"), std::string::npos);  // no Rig init.
+  EXPECT_NE(lines[2].find(",0.125,0.250,"), std::string::npos);
+}
+
+TEST(RuntimeBenchmark, GrowthExponentOfPowerLaws) {
+  std::vector<CalibrationRuntime> runs;
+  for (const int framesets : {10, 50, 100, 500}) {
+    runs.push_back(MakeRun(framesets, 5, 0.02 * framesets));  // linear
+    runs.push_back(MakeRun(framesets, 10, 1e-3 * framesets * framesets));
+  }
+  EXPECT_NEAR(GrowthExponent(runs, 5), 1.0, 1e-12);
+  EXPECT_NEAR(GrowthExponent(runs, 10), 2.0, 1e-12);
+  EXPECT_TRUE(std::isnan(GrowthExponent(runs, 4)));
+  // Failed runs do not count.
+  runs.back().success = false;
+  runs.back().cpu_seconds = 1e6;
+  EXPECT_NEAR(GrowthExponent(runs, 10), 2.0, 1e-12);
+  const std::string markdown = CalibrationRuntimeMarkdown(runs);
+  EXPECT_NE(markdown.find("framesets^1.00"), std::string::npos);
+  EXPECT_NE(markdown.find("framesets^2.00"), std::string::npos);
+}
+
+TEST(RuntimeBenchmark, SvgHasTwoSeriesPerCameraCount) {
+  std::vector<CalibrationRuntime> runs;
+  for (const int framesets : {10, 50, 100, 500}) {
+    runs.push_back(MakeRun(framesets, 5, 0.02 * framesets));
+    runs.push_back(MakeRun(framesets, 10, 0.04 * framesets));
+  }
+  const std::string svg = CalibrationRuntimeSvg(runs);
+  EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  for (const std::string label : {"5 cameras, wall", "5 cameras, CPU",
+                                  "10 cameras, wall", "10 cameras, CPU"}) {
+    EXPECT_NE(svg.find(label), std::string::npos) << label;
+  }
+  EXPECT_NE(svg.find("framesets"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rig_calibrator

@@ -1,0 +1,195 @@
+// The sub-commands end to end, in process: synthetic -> calibrate (from the
+// correspondence file) -> evaluate, and bad input giving a clear, non-zero
+// exit.
+#include "colmap_ext/commands/commands.h"
+
+#include <gtest/gtest.h>
+
+#include <boost/filesystem.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/io/map_reader.h"
+#include "tests/testing.h"
+
+namespace rig_calibrator {
+namespace {
+
+namespace fs = boost::filesystem;
+
+int RunCommand(int (*command)(int, char**),
+               std::vector<std::string> arguments) {
+  arguments.insert(arguments.begin(), "rig_calibrator");
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  return command(static_cast<int>(argv.size()), argv.data());
+}
+
+class CommandsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    data_ = temp_.File("data");
+    ASSERT_EQ(
+        RunCommand(&RunSynthetic, {"--output_path", data_, "--num_framesets",
+                                   "12", "--seed", "5"}),
+        EXIT_SUCCESS);
+  }
+
+  std::vector<std::string> CalibrateArguments(const std::string& output) {
+    return {"--correspondences_path",
+            data_ + "/correspondences.txt",
+            "--output_path",
+            output,
+            "--RigCalibrator.camera_model",
+            "OPENCV",
+            "--output_type",
+            "TXT"};
+  }
+
+  testing::ScopedTempDir temp_;
+  std::string data_;
+};
+
+TEST_F(CommandsTest, SyntheticCalibrateEvaluate) {
+  const std::string output = temp_.File("calibration");
+  ASSERT_EQ(RunCommand(&RunCalibrate, CalibrateArguments(output)),
+            EXIT_SUCCESS);
+  for (const std::string file :
+       {"cameras.txt", "images.txt", "points3D.txt", "rigs.txt", "frames.txt",
+        "rig_config.json", "rig_bundle_adjuster_config.json", "camchain.yaml",
+        "calibration_summary.json", "correspondences.txt"}) {
+    EXPECT_TRUE(fs::exists(output + "/" + file)) << file;
+  }
+  std::ifstream summary_file(output + "/calibration_summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["method"], "1dr");
+
+  const std::string errors = temp_.File("errors.json");
+  ASSERT_EQ(
+      RunCommand(&RunEvaluate,
+                 {"--reference_path", data_ + "/ground_truth/camchain.yaml",
+                  "--calibration_path", output, "--output_path", errors}),
+      EXIT_SUCCESS);
+  std::ifstream errors_file(errors);
+  const nlohmann::json error_json = nlohmann::json::parse(errors_file);
+  ASSERT_EQ(error_json["cameras"].size(), 5u);
+  for (const nlohmann::json& camera : error_json["cameras"]) {
+    EXPECT_LT(camera["rotation_deg"].get<double>(), 0.1);
+    EXPECT_LT(camera["center_error"].get<double>(), 0.005);
+    EXPECT_LT(camera["focal_error_percent"].get<double>(), 0.3);
+  }
+}
+
+TEST_F(CommandsTest, RerunFromWrittenCorrespondencesReproducesTheResult) {
+  const std::string first = temp_.File("first");
+  ASSERT_EQ(RunCommand(&RunCalibrate, CalibrateArguments(first)), EXIT_SUCCESS);
+  const std::string second = temp_.File("second");
+  std::vector<std::string> arguments = CalibrateArguments(second);
+  arguments[1] = first + "/correspondences.txt";
+  ASSERT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+  // The file rounds the pixels to what the format keeps, and Ceres's
+  // multi-threaded evaluation rounds differently from run to run: the
+  // intrinsics agree to far below any meaningful digit.
+  std::ifstream a(first + "/cameras.txt"), b(second + "/cameras.txt");
+  std::vector<std::string> tokens_a, tokens_b;
+  for (std::string token; a >> token;) tokens_a.push_back(token);
+  for (std::string token; b >> token;) tokens_b.push_back(token);
+  ASSERT_EQ(tokens_a.size(), tokens_b.size());
+  int num_numbers = 0;
+  for (size_t k = 0; k < tokens_a.size(); ++k) {
+    char* end = nullptr;
+    const double value_a = std::strtod(tokens_a[k].c_str(), &end);
+    if (*end != '\0' || end == tokens_a[k].c_str()) {
+      EXPECT_EQ(tokens_a[k], tokens_b[k]);
+      continue;
+    }
+    const double value_b = std::stod(tokens_b[k]);
+    EXPECT_NEAR(value_a, value_b, 1e-6 * std::max(1.0, std::abs(value_a)));
+    ++num_numbers;
+  }
+  EXPECT_GE(num_numbers, 5 * 11);  // id, size and 8 OPENCV parameters each
+}
+
+TEST_F(CommandsTest, BadInputFailsWithoutOutput) {
+  const std::string output = temp_.File("out");
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  // No input at all.
+  EXPECT_EQ(RunCommand(&RunCalibrate, {"--output_path", output}), EXIT_FAILURE);
+  // Unknown method, unknown camera model, unknown option.
+  std::vector<std::string> bad_method = arguments;
+  bad_method.insert(bad_method.end(), {"--RigCalibrator.method", "magic"});
+  EXPECT_EQ(RunCommand(&RunCalibrate, bad_method), EXIT_FAILURE);
+  std::vector<std::string> bad_model = arguments;
+  bad_model[5] = "NOT_A_MODEL";
+  EXPECT_EQ(RunCommand(&RunCalibrate, bad_model), EXIT_FAILURE);
+  std::vector<std::string> bad_camera = arguments;
+  bad_camera[5] = "cam9:OPENCV";
+  EXPECT_EQ(RunCommand(&RunCalibrate, bad_camera), EXIT_FAILURE);
+  std::vector<std::string> unknown_option = arguments;
+  unknown_option.push_back("--no_such_option");
+  EXPECT_EQ(RunCommand(&RunCalibrate, unknown_option), EXIT_FAILURE);
+  // Missing correspondence file and missing map.
+  std::vector<std::string> missing_file = arguments;
+  missing_file[1] = temp_.File("missing.txt");
+  EXPECT_EQ(RunCommand(&RunCalibrate, missing_file), EXIT_FAILURE);
+  std::vector<std::string> missing_map = arguments;
+  missing_map.insert(missing_map.end(), {"--input_path", temp_.File("nomap")});
+  EXPECT_EQ(RunCommand(&RunCalibrate, missing_map), EXIT_FAILURE);
+  // known needs intrinsics.
+  std::vector<std::string> known = arguments;
+  known.insert(known.end(), {"--RigCalibrator.method", "known"});
+  EXPECT_EQ(RunCommand(&RunCalibrate, known), EXIT_FAILURE);
+  EXPECT_FALSE(fs::exists(output));
+}
+
+TEST_F(CommandsTest, ExistingOutputIsKeptUnlessOverwrite) {
+  const std::string output = temp_.File("out");
+  fs::create_directories(output);
+  std::ofstream(output + "/keep.txt") << "user data";
+  EXPECT_EQ(RunCommand(&RunCalibrate, CalibrateArguments(output)),
+            EXIT_FAILURE);
+  EXPECT_TRUE(fs::exists(output + "/keep.txt"));
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  arguments.insert(arguments.end(), {"--overwrite", "1"});
+  EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+  EXPECT_TRUE(fs::exists(output + "/rig_config.json"));
+}
+
+TEST_F(CommandsTest, KnownMethodWithIntrinsicsFile) {
+  const std::string output = temp_.File("known");
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  arguments.insert(arguments.end(), {"--RigCalibrator.method", "known",
+                                     "--RigCalibrator.intrinsics_path",
+                                     data_ + "/ground_truth/camchain.yaml"});
+  EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+}
+
+TEST(MapReader, NonColmapFilesAreRejected) {
+  testing::ScopedTempDir temp;
+  colmap::Reconstruction map;
+  std::string error;
+  EXPECT_FALSE(ReadMap(temp.File("none"), &map, &error));
+  EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+  for (const std::string name : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    std::ofstream(temp.File(name)) << "this is not a COLMAP model at all";
+  }
+  EXPECT_FALSE(ReadMap(temp.path(), &map, &error));
+  EXPECT_NE(error.find("not a COLMAP binary model file"), std::string::npos)
+      << error;
+}
+
+TEST(Evaluate, MissingFilesFail) {
+  testing::ScopedTempDir temp;
+  EXPECT_EQ(
+      RunCommand(&RunEvaluate, {"--reference_path", temp.File("a.json"),
+                                "--calibration_path", temp.File("b.yaml")}),
+      EXIT_FAILURE);
+  EXPECT_EQ(RunCommand(&RunEvaluate, {}), EXIT_FAILURE);
+}
+
+}  // namespace
+}  // namespace rig_calibrator

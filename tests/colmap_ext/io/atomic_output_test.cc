@@ -1,0 +1,121 @@
+#include "colmap_ext/io/atomic_output.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "tests/testing.h"
+
+namespace rig_calibrator {
+namespace {
+
+namespace fs = std::filesystem;
+
+size_t NumEntries(const std::string& folder) {
+  return std::distance(fs::directory_iterator(folder),
+                       fs::directory_iterator());
+}
+
+bool WriteTwoFiles(const std::string& folder, std::string* error) {
+  std::ofstream(folder + "/a.txt") << "a";
+  return WriteFileAtomically(folder + "/b.txt", "b", error);
+}
+
+TEST(AtomicOutput, FileIsReplacedWhole) {
+  testing::ScopedTempDir dir;
+  const std::string path = dir.File("f.txt");
+  std::string error;
+  ASSERT_TRUE(WriteFileAtomically(path, "first", &error)) << error;
+  ASSERT_TRUE(WriteFileAtomically(path, "second", &error)) << error;
+  EXPECT_EQ(testing::ReadBytes(path), "second");
+  EXPECT_EQ(NumEntries(dir.path()), 1u);
+  EXPECT_FALSE(WriteFileAtomically(dir.File("missing/f.txt"), "x", &error));
+}
+
+TEST(AtomicOutput, FailureMidwayLeavesNothing) {
+  testing::ScopedTempDir dir;
+  const std::string output = dir.File("out");
+  std::string error;
+  const bool written = WriteFolderAtomically(
+      output, OutputFolderOptions(),
+      [](const std::string& folder, std::string* error) {
+        EXPECT_TRUE(WriteTwoFiles(folder, error));
+        EXPECT_TRUE(fs::exists(folder + "/b.txt"));
+        *error = "disk full";
+        return false;
+      },
+      &error);
+  EXPECT_FALSE(written);
+  EXPECT_EQ(error, "disk full");
+  EXPECT_EQ(NumEntries(dir.path()), 0u);
+
+  // An exception midway is passed on, and leaves nothing either.
+  EXPECT_THROW(WriteFolderAtomically(
+                   output, OutputFolderOptions(),
+                   [](const std::string& folder, std::string* error) -> bool {
+                     WriteTwoFiles(folder, error);
+                     throw std::runtime_error("crash");
+                   },
+                   &error),
+               std::runtime_error);
+  EXPECT_EQ(NumEntries(dir.path()), 0u);
+}
+
+TEST(AtomicOutput, FolderAppearsWhole) {
+  testing::ScopedTempDir dir;
+  const std::string output = dir.File("out");
+  std::string error;
+  ASSERT_TRUE(WriteFolderAtomically(output, OutputFolderOptions(),
+                                    WriteTwoFiles, &error))
+      << error;
+  EXPECT_EQ(testing::ReadBytes(output + "/a.txt"), "a");
+  EXPECT_EQ(testing::ReadBytes(output + "/b.txt"), "b");
+  EXPECT_EQ(NumEntries(dir.path()), 1u);
+
+  // Non-empty: refused, then replaced with overwrite.
+  EXPECT_FALSE(WriteFolderAtomically(output, OutputFolderOptions(),
+                                     WriteTwoFiles, &error));
+  EXPECT_NE(error.find("pass --overwrite"), std::string::npos) << error;
+  std::ofstream(output + "/old.txt") << "old";
+  OutputFolderOptions overwrite;
+  overwrite.overwrite = true;
+  ASSERT_TRUE(WriteFolderAtomically(output, overwrite, WriteTwoFiles, &error))
+      << error;
+  EXPECT_FALSE(fs::exists(output + "/old.txt"));
+  EXPECT_EQ(NumEntries(dir.path()), 1u);
+
+  // A file in the way, or a missing parent folder.
+  std::ofstream(dir.File("file")) << "x";
+  EXPECT_FALSE(WriteFolderAtomically(dir.File("file"), overwrite, WriteTwoFiles,
+                                     &error));
+  EXPECT_NE(error.find("is not a folder"), std::string::npos);
+  EXPECT_FALSE(WriteFolderAtomically(dir.File("no/out"), overwrite,
+                                     WriteTwoFiles, &error));
+  EXPECT_NE(error.find("does not exist"), std::string::npos);
+}
+
+TEST(AtomicOutput, OutputMustNotOverlapInputs) {
+  testing::ScopedTempDir dir;
+  fs::create_directories(dir.File("map/sparse/0"));
+  OutputFolderOptions options;
+  options.overwrite = true;
+  options.input_paths = {dir.File("map/sparse/0"), dir.File("images")};
+  std::string error;
+  for (const std::string& output :
+       {dir.File("map/sparse/0"), dir.File("map/sparse/0/"),
+        dir.File("map/sparse/0/out"), dir.File("map"),
+        dir.File("images/../map/sparse")}) {
+    EXPECT_FALSE(WriteFolderAtomically(output, options, WriteTwoFiles, &error))
+        << output;
+    EXPECT_NE(error.find("overlaps the input path"), std::string::npos);
+  }
+  EXPECT_TRUE(fs::exists(dir.File("map/sparse/0")));
+  EXPECT_TRUE(WriteFolderAtomically(dir.File("map/sparse/1"), options,
+                                    WriteTwoFiles, &error))
+      << error;
+}
+
+}  // namespace
+}  // namespace rig_calibrator

@@ -1,0 +1,50 @@
+#include "colmap_ext/io/number_text.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace rig_calibrator {
+namespace {
+
+TEST(NumberText, DoublesRoundTripBitForBit) {
+  for (const double value : {312.41, 1e-5, -0.5, 0.1 + 0.2, 6.02214076e23}) {
+    double parsed = 0;
+    ASSERT_TRUE(ParseDouble(FormatDouble(value), &parsed)) << value;
+    EXPECT_EQ(parsed, value);
+  }
+}
+
+TEST(NumberText, YamlFloatsAlwaysHaveADecimalPoint) {
+  EXPECT_EQ(FormatYamlFloat(500.0), "500.0");
+  EXPECT_EQ(FormatYamlFloat(1e-5), "1.0e-05");
+  EXPECT_EQ(FormatYamlFloat(-0.25), "-0.25");
+}
+
+TEST(NumberText, ParseDoubleIsStrict) {
+  double value = 7;
+  EXPECT_TRUE(ParseDouble("+1.5", &value));
+  EXPECT_EQ(value, 1.5);
+  for (const char* bad :
+       {"", "+", "+-1", "1.5x", " 1", "nan", "inf", "1e999"}) {
+    value = 7;
+    EXPECT_FALSE(ParseDouble(bad, &value)) << bad;
+    EXPECT_EQ(value, 7) << bad;
+  }
+}
+
+TEST(NumberText, ParseInt64IsStrict) {
+  int64_t value = 7;
+  EXPECT_TRUE(ParseInt64("+42", &value));
+  EXPECT_EQ(value, 42);
+  EXPECT_TRUE(ParseInt64("-9223372036854775808", &value));
+  EXPECT_EQ(value, std::numeric_limits<int64_t>::min());
+  for (const char* bad : {"", "1.0", "9223372036854775808", "+-3", "12a"}) {
+    value = 7;
+    EXPECT_FALSE(ParseInt64(bad, &value)) << bad;
+    EXPECT_EQ(value, 7) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace rig_calibrator

@@ -1,0 +1,506 @@
+#include "src/calibration/camera_upgrader.h"
+
+#include <colmap/base/camera_models.h>
+#include <colmap/util/random.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "src/geometry/rigid3d.h"
+
+namespace rig_calibrator {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+colmap::Camera MakeCamera(const std::string& model_name, const int width,
+                          const int height, const std::vector<double>& params) {
+  colmap::Camera camera;
+  camera.SetModelIdFromName(model_name);
+  camera.SetWidth(width);
+  camera.SetHeight(height);
+  camera.SetParams(params);
+  return camera;
+}
+
+struct SceneOptions {
+  int num_points = 400;
+  double max_ray_angle_deg = 60;  // rays are drawn within this cone
+  double min_distance = 2;
+  double max_distance = 10;
+  double noise_px = 0;
+  double outlier_ratio = 0;
+  unsigned seed = 1;
+};
+
+// Correspondences of a camera with a random cam_from_world whose tz the
+// upgrade must find: points at min..max_distance along rays drawn uniformly
+// in a cone around the optical axis, kept if they project into the image.
+struct Scene {
+  double tz = 0;
+  std::vector<Eigen::Vector2d> points2D;
+  std::vector<Eigen::Vector3d> points_cam;  // R X + (tx, ty, 0)
+  std::vector<char> is_outlier;
+};
+
+Scene MakeScene(const colmap::Camera& camera, const SceneOptions& options) {
+  std::mt19937 generator(options.seed);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  std::normal_distribution<double> normal(0, 1);
+  const Eigen::Quaterniond rotation =
+      Eigen::Quaterniond(normal(generator), normal(generator),
+                         normal(generator), normal(generator));
+  const Rigid3d cam_from_world(
+      rotation,
+      Eigen::Vector3d(2 * uniform(generator) - 1, 2 * uniform(generator) - 1,
+                      2 * uniform(generator) - 1));
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+
+  Scene scene;
+  scene.tz = cam_from_world.translation.z();
+  const double min_cos = std::cos(options.max_ray_angle_deg * kPi / 180);
+  while (static_cast<int>(scene.points2D.size()) < options.num_points) {
+    const double cos_theta = min_cos + (1 - min_cos) * uniform(generator);
+    const double sin_theta = std::sqrt(1 - cos_theta * cos_theta);
+    const double phi = 2 * kPi * uniform(generator);
+    const double distance =
+        options.min_distance +
+        (options.max_distance - options.min_distance) * uniform(generator);
+    const Eigen::Vector3d point_in_cam =
+        distance * Eigen::Vector3d(sin_theta * std::cos(phi),
+                                   sin_theta * std::sin(phi), cos_theta);
+    Eigen::Vector2d point2D;
+    colmap::CameraModelWorldToImage(
+        camera.ModelId(), camera.Params(), point_in_cam.x() / point_in_cam.z(),
+        point_in_cam.y() / point_in_cam.z(), &point2D.x(), &point2D.y());
+    if (point2D.x() < 0 || point2D.y() < 0 || point2D.x() > camera.Width() ||
+        point2D.y() > camera.Height()) {
+      continue;
+    }
+    const Eigen::Vector3d point3D = world_from_cam * point_in_cam;
+    Eigen::Vector3d point_cam = cam_from_world * point3D;
+    point_cam.z() -= scene.tz;
+    const bool is_outlier = uniform(generator) < options.outlier_ratio;
+    if (is_outlier) {
+      Eigen::Vector2d wrong;
+      do {
+        wrong = Eigen::Vector2d(camera.Width() * uniform(generator),
+                                camera.Height() * uniform(generator));
+      } while ((wrong - point2D).norm() < 20);
+      point2D = wrong;
+    } else {
+      point2D += options.noise_px *
+                 Eigen::Vector2d(normal(generator), normal(generator));
+    }
+    scene.points2D.push_back(point2D);
+    scene.points_cam.push_back(point_cam);
+    scene.is_outlier.push_back(is_outlier);
+  }
+  return scene;
+}
+
+// The input camera: the true model and size, the principal point off by
+// `principal_point_error` px, every other parameter wrong.
+colmap::Camera MakeInputCamera(const colmap::Camera& truth,
+                               const Eigen::Vector2d& principal_point_error) {
+  colmap::Camera camera = truth;
+  for (double& param : camera.Params()) {
+    param = 0.5;
+  }
+  camera.SetPrincipalPointX(truth.PrincipalPointX() +
+                            principal_point_error.x());
+  camera.SetPrincipalPointY(truth.PrincipalPointY() +
+                            principal_point_error.y());
+  return camera;
+}
+
+struct ModelCase {
+  std::string model_name;
+  std::vector<double> params;  // 640 x 480, principal point off by (15, -12)
+  double max_ray_angle_deg;
+};
+
+std::vector<ModelCase> AllModelCases() {
+  return {
+      {"SIMPLE_PINHOLE", {500, 335, 228}, 60},
+      {"PINHOLE", {500, 503, 335, 228}, 60},
+      {"SIMPLE_RADIAL", {500, 335, 228, -0.15}, 60},
+      {"RADIAL", {500, 335, 228, -0.3, 0.08}, 60},
+      {"OPENCV", {500, 502, 335, 228, -0.3, 0.08, 0.001, -0.0015}, 60},
+      {"FULL_OPENCV",
+       {500, 502, 335, 228, -0.3, 0.08, 0.001, -0.0015, -0.01, 0.02, -0.005,
+        0.001},
+       60},
+      {"SIMPLE_RADIAL_FISHEYE", {300, 335, 228, 0.03}, 75},
+      {"RADIAL_FISHEYE", {300, 335, 228, 0.03, -0.005}, 75},
+      {"OPENCV_FISHEYE",
+       {300, 302, 335, 228, 0.02, -0.005, 0.002, -0.0005},
+       75},
+      {"THIN_PRISM_FISHEYE",
+       {300, 302, 335, 228, 0.02, -0.005, 0.0005, -0.0003, 0.002, -0.0005,
+        0.0004, -0.0002},
+       75},
+  };
+}
+
+// Tolerances on exact data: the focal lengths relative, the principal point
+// in pixels, distortion absolute. FULL_OPENCV's rational distortion
+// (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6) is nearly
+// unchanged when numerator and denominator gain a common factor, so its
+// terms stop at ~2.5e-6 (measured) with the reprojection error at 4e-10 px.
+constexpr double kFocalRelativeTolerance = 1e-8;
+constexpr double kPrincipalPointTolerancePx = 1e-6;
+constexpr double kDistortionTolerance = 1e-8;
+constexpr double kRationalDistortionTolerance = 1e-5;
+
+void ExpectParamsNear(const colmap::Camera& camera, const colmap::Camera& truth,
+                      const double focal_relative_tolerance,
+                      const double principal_point_tolerance_px,
+                      const double distortion_tolerance) {
+  ASSERT_EQ(camera.NumParams(), truth.NumParams());
+  for (const size_t i : truth.FocalLengthIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
+                focal_relative_tolerance * truth.Params()[i]);
+  }
+  for (const size_t i : truth.PrincipalPointIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
+                principal_point_tolerance_px);
+  }
+  for (const size_t i : truth.ExtraParamsIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i], distortion_tolerance)
+        << "parameter " << i;
+  }
+}
+
+void ExpectFocalAndPrincipalPointNear(const colmap::Camera& camera,
+                                      const colmap::Camera& truth,
+                                      const double focal_relative_tolerance,
+                                      const double principal_point_tolerance) {
+  for (const size_t i : truth.FocalLengthIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
+                focal_relative_tolerance * truth.Params()[i]);
+  }
+  for (const size_t i : truth.PrincipalPointIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
+                principal_point_tolerance);
+  }
+}
+
+// At least `min_inlier_recall` of the true inliers are inliers and at most
+// `max_outlier_share` of the wrong matches.
+void ExpectInliersRecovered(const Scene& scene,
+                            const CameraUpgradeResult& result,
+                            const double min_inlier_recall,
+                            const double max_outlier_share) {
+  ASSERT_EQ(result.inlier_mask.size(), scene.is_outlier.size());
+  int num_true_inliers = 0, num_found_inliers = 0;
+  int num_outliers = 0, num_accepted_outliers = 0;
+  for (size_t i = 0; i < scene.is_outlier.size(); ++i) {
+    if (scene.is_outlier[i]) {
+      ++num_outliers;
+      num_accepted_outliers += result.inlier_mask[i];
+    } else {
+      ++num_true_inliers;
+      num_found_inliers += result.inlier_mask[i];
+    }
+  }
+  EXPECT_EQ(result.num_inliers, num_found_inliers + num_accepted_outliers);
+  EXPECT_GE(num_found_inliers, min_inlier_recall * num_true_inliers);
+  EXPECT_LE(num_accepted_outliers, max_outlier_share * num_outliers);
+}
+
+// Exact data: tz and every parameter of every supported model.
+TEST(CameraUpgrader, ExactDataRecoversEveryModel) {
+  for (const ModelCase& model_case : AllModelCases()) {
+    SCOPED_TRACE(model_case.model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    SceneOptions scene_options;
+    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
+    const Scene scene = MakeScene(truth, scene_options);
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result))
+        << result.error_message;
+    EXPECT_EQ(result.num_inliers, scene_options.num_points);
+    EXPECT_LT(result.rms_px, 1e-8);
+    EXPECT_TRUE(result.well_conditioned);
+    EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+    ExpectParamsNear(
+        camera, truth, kFocalRelativeTolerance, kPrincipalPointTolerancePx,
+        model_case.model_name == "FULL_OPENCV" ? kRationalDistortionTolerance
+                                               : kDistortionTolerance);
+  }
+}
+
+// A principal point guess at the image center, 19 px from the truth.
+TEST(CameraUpgrader, ExactDataFromImageCenter) {
+  for (const ModelCase& model_case : AllModelCases()) {
+    if (model_case.model_name != "OPENCV" &&
+        model_case.model_name != "OPENCV_FISHEYE") {
+      continue;
+    }
+    SCOPED_TRACE(model_case.model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    SceneOptions scene_options;
+    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
+    const Scene scene = MakeScene(truth, scene_options);
+    colmap::Camera camera =
+        MakeInputCamera(truth, Eigen::Vector2d(320 - truth.PrincipalPointX(),
+                                               240 - truth.PrincipalPointY()));
+
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result))
+        << result.error_message;
+    EXPECT_EQ(result.num_inliers, scene_options.num_points);
+    EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+    ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+                     kPrincipalPointTolerancePx, kDistortionTolerance);
+  }
+}
+
+// 0.5 px noise and 30% wrong matches, pooled frames (1000 correspondences).
+// Measured: focal <= 0.08%, principal point <= 0.05 px, tz <= 1.5 mm (its
+// 1-sigma uncertainty is ~1.5 mm), every inlier found, no outlier accepted.
+TEST(CameraUpgrader, NoisyDataWithOutliers) {
+  for (const ModelCase& model_case : AllModelCases()) {
+    SCOPED_TRACE(model_case.model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    SceneOptions scene_options;
+    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
+    scene_options.num_points = 1000;
+    scene_options.noise_px = 0.5;
+    scene_options.outlier_ratio = 0.3;
+    const Scene scene = MakeScene(truth, scene_options);
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result))
+        << result.error_message;
+    ExpectInliersRecovered(scene, result, 0.99, 0.005);
+    // 0.5 px per coordinate: 0.71 px in 2D.
+    EXPECT_GT(result.rms_px, 0.6);
+    EXPECT_LT(result.rms_px, 0.8);
+    EXPECT_NEAR(result.tz, scene.tz, 0.005);
+    ExpectFocalAndPrincipalPointNear(camera, truth, 0.002, 1.0);
+    EXPECT_TRUE(result.well_conditioned);
+    EXPECT_LT(std::abs(result.tz_focal_correlation), 0.95);
+    EXPECT_GT(result.focal_stddev_at_1px, 0);
+    EXPECT_LT(result.focal_stddev_at_1px, 0.01 * camera.MeanFocalLength());
+  }
+}
+
+// The `rd` baseline upgrades single images: 150 correspondences, 0.5 px
+// noise, 20% wrong matches. Measured: focal <= 0.34% (fisheye models; the
+// others <= 0.26%), principal point <= 0.09 px, tz <= 2.4 mm.
+TEST(CameraUpgrader, SingleImage) {
+  for (const ModelCase& model_case : AllModelCases()) {
+    SCOPED_TRACE(model_case.model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    SceneOptions scene_options;
+    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
+    scene_options.num_points = 150;
+    scene_options.noise_px = 0.5;
+    scene_options.outlier_ratio = 0.2;
+    scene_options.seed = 2;
+    const Scene scene = MakeScene(truth, scene_options);
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result))
+        << result.error_message;
+    ExpectInliersRecovered(scene, result, 0.97, 0.02);
+    EXPECT_NEAR(result.tz, scene.tz, 0.02);
+    ExpectFocalAndPrincipalPointNear(camera, truth, 0.005, 1.0);
+  }
+}
+
+// Points all at 9.9-10.1 m in a 5 degree cone: only f / (c + tz) is
+// observed. Measured: correlation >= 0.995, focal stddev at 1 px >= 110 px.
+TEST(CameraUpgrader, EqualDepthsNarrowViewIsPoorlyConditioned) {
+  for (const ModelCase& model_case : AllModelCases()) {
+    if (model_case.model_name != "SIMPLE_PINHOLE" &&
+        model_case.model_name != "OPENCV" &&
+        model_case.model_name != "OPENCV_FISHEYE") {
+      continue;
+    }
+    SCOPED_TRACE(model_case.model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    SceneOptions scene_options;
+    scene_options.max_ray_angle_deg = 5;
+    scene_options.min_distance = 9.9;
+    scene_options.max_distance = 10.1;
+    scene_options.noise_px = 0.5;
+    const Scene scene = MakeScene(truth, scene_options);
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(1, -1));
+
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result))
+        << result.error_message;
+    EXPECT_FALSE(result.well_conditioned);
+    EXPECT_GT(std::abs(result.tz_focal_correlation), 0.99);
+    EXPECT_GT(result.focal_stddev_at_1px, 0.1 * camera.MeanFocalLength());
+  }
+}
+
+// A camera pooled over many frames: RANSAC on a subset, inliers on all.
+TEST(CameraUpgrader, RansacOnSubsetOfManyPoints) {
+  const colmap::Camera truth =
+      MakeCamera("OPENCV_FISHEYE", 640, 480,
+                 {300, 302, 335, 228, 0.02, -0.005, 0.002, -0.0005});
+  SceneOptions scene_options;
+  scene_options.max_ray_angle_deg = 75;
+  scene_options.num_points = 20000;
+  scene_options.noise_px = 0.5;
+  scene_options.outlier_ratio = 0.3;
+  const Scene scene = MakeScene(truth, scene_options);
+  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+  CameraUpgradeOptions options;
+  options.max_num_ransac_points = 1000;
+  CameraUpgradeResult result;
+  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
+                            &result))
+      << result.error_message;
+  ExpectInliersRecovered(scene, result, 0.99, 0.001);
+  EXPECT_NEAR(result.tz, scene.tz, 0.002);
+  ExpectFocalAndPrincipalPointNear(camera, truth, 0.0005, 0.1);
+}
+
+TEST(CameraUpgrader, FixedPrincipalPoint) {
+  const colmap::Camera truth =
+      MakeCamera("RADIAL", 640, 480, {500, 335, 228, -0.3, 0.08});
+  const Scene scene = MakeScene(truth, SceneOptions());
+  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d::Zero());
+  CameraUpgradeOptions options;
+  options.refine_principal_point = false;
+  CameraUpgradeResult result;
+  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
+                            &result))
+      << result.error_message;
+  EXPECT_EQ(camera.PrincipalPointX(), truth.PrincipalPointX());
+  EXPECT_EQ(camera.PrincipalPointY(), truth.PrincipalPointY());
+  EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+  ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+                   kPrincipalPointTolerancePx, kDistortionTolerance);
+
+  // With a wrong fixed principal point the other parameters compensate
+  // only partly.
+  colmap::Camera shifted = MakeInputCamera(truth, Eigen::Vector2d(3, 0));
+  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &shifted,
+                            &result));
+  EXPECT_EQ(shifted.PrincipalPointX(), truth.PrincipalPointX() + 3);
+  EXPECT_GT(result.rms_px, 0.1);
+}
+
+// The result depends only on the input, not on COLMAP's random state.
+TEST(CameraUpgrader, Deterministic) {
+  const colmap::Camera truth = MakeCamera(
+      "OPENCV", 640, 480, {500, 502, 335, 228, -0.3, 0.08, 0.001, -0.0015});
+  SceneOptions scene_options;
+  scene_options.noise_px = 0.5;
+  scene_options.outlier_ratio = 0.3;
+  const Scene scene = MakeScene(truth, scene_options);
+  std::vector<std::vector<double>> params;
+  std::vector<double> tzs;
+  for (const unsigned seed : {1u, 2u}) {
+    colmap::SetPRNGSeed(seed);
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                              scene.points_cam, &camera, &result));
+    params.push_back(camera.Params());
+    tzs.push_back(result.tz);
+  }
+  EXPECT_EQ(params[0], params[1]);
+  EXPECT_EQ(tzs[0], tzs[1]);
+}
+
+TEST(CameraUpgrader, NonFiniteCorrespondencesAreOutliers) {
+  const colmap::Camera truth =
+      MakeCamera("SIMPLE_RADIAL", 640, 480, {500, 335, 228, -0.15});
+  Scene scene = MakeScene(truth, SceneOptions());
+  scene.points2D[3].x() = std::numeric_limits<double>::quiet_NaN();
+  scene.points_cam[7].z() = std::numeric_limits<double>::infinity();
+  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+  CameraUpgradeResult result;
+  ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                            scene.points_cam, &camera, &result))
+      << result.error_message;
+  EXPECT_EQ(result.num_inliers, static_cast<int>(scene.points2D.size()) - 2);
+  EXPECT_FALSE(result.inlier_mask[3]);
+  EXPECT_FALSE(result.inlier_mask[7]);
+  EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+}
+
+TEST(CameraUpgrader, RejectsUnsupportedModelAndBadInput) {
+  const colmap::Camera truth =
+      MakeCamera("RADIAL", 640, 480, {500, 335, 228, -0.3, 0.08});
+  const Scene scene = MakeScene(truth, SceneOptions());
+  CameraUpgradeResult result;
+
+  colmap::Camera fov = MakeCamera("FOV", 640, 480, {500, 500, 320, 240, 0.1});
+  const std::vector<double> fov_params = fov.Params();
+  EXPECT_FALSE(IsUpgradeSupportedCameraModel(fov.ModelId()));
+  EXPECT_FALSE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                             scene.points_cam, &fov, &result));
+  EXPECT_NE(result.error_message.find("FOV"), std::string::npos);
+  EXPECT_EQ(fov.Params(), fov_params);
+
+  for (const ModelCase& model_case : AllModelCases()) {
+    EXPECT_TRUE(IsUpgradeSupportedCameraModel(
+        colmap::CameraModelNameToId(model_case.model_name)));
+  }
+
+  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d::Zero());
+  const std::vector<double> params = camera.Params();
+  // Sizes differ.
+  EXPECT_FALSE(
+      UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                    {scene.points_cam.begin(), scene.points_cam.end() - 1},
+                    &camera, &result));
+  // Too few correspondences.
+  EXPECT_FALSE(
+      UpgradeCamera(CameraUpgradeOptions(),
+                    {scene.points2D.begin(), scene.points2D.begin() + 4},
+                    {scene.points_cam.begin(), scene.points_cam.begin() + 4},
+                    &camera, &result));
+  // Invalid options.
+  CameraUpgradeOptions options;
+  options.max_error_px = 0;
+  EXPECT_FALSE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
+                             &result));
+  // Parameters that do not match the model.
+  colmap::Camera wrong_params = camera;
+  wrong_params.Params().pop_back();
+  EXPECT_FALSE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                             scene.points_cam, &wrong_params, &result));
+  // Every 3D point on the wrong half-line of the radial pose.
+  std::vector<Eigen::Vector3d> flipped = scene.points_cam;
+  for (Eigen::Vector3d& point : flipped) {
+    point.x() = -point.x();
+    point.y() = -point.y();
+  }
+  EXPECT_FALSE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D, flipped,
+                             &camera, &result));
+  EXPECT_FALSE(result.error_message.empty());
+  EXPECT_EQ(camera.Params(), params);
+  EXPECT_FALSE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
+                             scene.points_cam, nullptr, &result));
+}
+
+}  // namespace
+}  // namespace rig_calibrator

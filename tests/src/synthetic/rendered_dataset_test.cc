@@ -1,0 +1,137 @@
+#include "src/synthetic/rendered_dataset.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+namespace rig_calibrator {
+namespace {
+
+RenderedDatasetOptions Options(RigPreset preset, SceneType scene) {
+  RenderedDatasetOptions options;
+  options.preset = preset;
+  options.scene = scene;
+  options.seed = 11;
+  return options;
+}
+
+// Fraction of a camera's view (a coarse grid of pixel rays) that hits the
+// scene rather than the sky.
+double SurfaceFraction(const TexturedScene& scene, const colmap::Camera& camera,
+                       const Rigid3d& cam_from_world) {
+  int num_hits = 0;
+  int num_rays = 0;
+  for (double y = 0.5; y < camera.Height(); y += camera.Height() / 12.0) {
+    for (double x = 0.5; x < camera.Width(); x += camera.Width() / 16.0) {
+      const Eigen::Vector3d ray =
+          cam_from_world.rotation.conjugate() *
+          camera.ImageToWorld(Eigen::Vector2d(x, y)).homogeneous().normalized();
+      SceneHit hit;
+      num_hits += scene.Intersect(cam_from_world.Center(), ray, &hit);
+      ++num_rays;
+    }
+  }
+  return static_cast<double>(num_hits) / num_rays;
+}
+
+TEST(RenderedDataset, EveryRigFitsEveryScene) {
+  for (const SceneType scene : AllSceneTypes()) {
+    for (const RigPreset preset : AllRigPresets()) {
+      RenderedDatasetPlan plan;
+      std::string error;
+      ASSERT_TRUE(PlanRenderedDataset(Options(preset, scene), &plan, &error))
+          << SceneTypeName(scene) << " " << RigPresetName(preset) << ": "
+          << error;
+      ASSERT_EQ(plan.map_image_names.size(), 60u);
+      ASSERT_EQ(plan.map_cam_from_world.size(), 60u);
+      ASSERT_EQ(plan.rig.rig_from_world.size(), 12u);
+      ASSERT_EQ(plan.frameset_names.size(), 12u);
+      EXPECT_EQ(plan.RigImageName(1, 3), "cam1/000003.png");
+      EXPECT_EQ(plan.map_image_names[7], "map_000007.png");
+      // The rig frame is the reference camera's.
+      EXPECT_NEAR(plan.rig.cam_from_rig[0].translation.norm(), 0, 1e-12);
+      for (const Rigid3d& rig_from_world : plan.rig.rig_from_world) {
+        for (size_t c = 0; c < plan.rig.cameras.size(); ++c) {
+          const Rigid3d cam_from_world =
+              plan.rig.cam_from_rig[c] * rig_from_world;
+          EXPECT_TRUE(plan.scene.IsFree(cam_from_world.Center(), 0.25));
+          // Outdoors some cameras look up at the sky, but most of each view
+          // is textured.
+          EXPECT_GT(
+              SurfaceFraction(plan.scene, plan.rig.cameras[c], cam_from_world),
+              0.5);
+        }
+      }
+    }
+  }
+}
+
+// Consecutive map images differ by bounded steps (sequential matching needs
+// overlap), the loop closes, and the views cover every heading.
+TEST(RenderedDataset, MapSequenceOverlapsAndCoversTheScene) {
+  for (const SceneType scene : AllSceneTypes()) {
+    RenderedDatasetPlan plan;
+    std::string error;
+    ASSERT_TRUE(
+        PlanRenderedDataset(Options(RigPreset::kRing5, scene), &plan, &error))
+        << error;
+    const int n = static_cast<int>(plan.map_cam_from_world.size());
+    std::set<int> heading_sectors;
+    for (int i = 0; i < n; ++i) {
+      const Rigid3d& pose = plan.map_cam_from_world[i];
+      const Rigid3d& next = plan.map_cam_from_world[(i + 1) % n];
+      EXPECT_LT((pose.Center() - next.Center()).norm(),
+                scene == SceneType::kRoom ? 0.4 : 2.0)
+          << SceneTypeName(scene) << " image " << i;
+      EXPECT_LT(RotationDifferenceDeg(pose.rotation, next.rotation), 20.0)
+          << SceneTypeName(scene) << " image " << i;
+      EXPECT_TRUE(plan.scene.IsFree(pose.Center(), 0.25));
+      EXPECT_GT(SurfaceFraction(plan.scene, plan.map_camera, pose), 0.7);
+      const Eigen::Vector3d view =
+          pose.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+      heading_sectors.insert(static_cast<int>(
+          std::floor((std::atan2(view.y(), view.x()) + M_PI) / (M_PI / 4))));
+    }
+    EXPECT_EQ(heading_sectors.size(), 8u) << SceneTypeName(scene);
+  }
+}
+
+TEST(RenderedDataset, DeterministicForASeed) {
+  RenderedDatasetPlan first, second, other;
+  std::string error;
+  RenderedDatasetOptions options =
+      Options(RigPreset::kFisheyeHelmet5, SceneType::kCourtyard);
+  ASSERT_TRUE(PlanRenderedDataset(options, &first, &error));
+  ASSERT_TRUE(PlanRenderedDataset(options, &second, &error));
+  options.seed = 12;
+  ASSERT_TRUE(PlanRenderedDataset(options, &other, &error));
+  for (size_t j = 0; j < first.rig.rig_from_world.size(); ++j) {
+    EXPECT_EQ(first.rig.rig_from_world[j].Qvec(),
+              second.rig.rig_from_world[j].Qvec());
+    EXPECT_EQ(first.rig.rig_from_world[j].translation,
+              second.rig.rig_from_world[j].translation);
+  }
+  EXPECT_NE(first.rig.rig_from_world[0].translation,
+            other.rig.rig_from_world[0].translation);
+}
+
+TEST(RenderedDataset, RejectsInvalidOptions) {
+  RenderedDatasetPlan plan;
+  std::string error;
+  RenderedDatasetOptions options;
+  options.num_map_images = 2;
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("num_map_images"), std::string::npos);
+  options = RenderedDatasetOptions();
+  options.map_focal_length = -1;
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("map_focal_length"), std::string::npos);
+  options = RenderedDatasetOptions();
+  options.rig_height = 2.95;  // cameras in the room's ceiling
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("would stand in a wall"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace rig_calibrator

@@ -1,0 +1,342 @@
+#include "src/synthetic/scene_renderer.h"
+
+#include <colmap/feature/sift.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "src/synthetic/rendered_dataset.h"
+#include "src/synthetic/synthetic_rig.h"
+#include "src/synthetic/textured_scene.h"
+
+namespace rig_calibrator {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+colmap::Camera MakeCamera(const std::string& model, int width, int height,
+                          const std::vector<double>& params) {
+  colmap::Camera camera;
+  camera.SetModelIdFromName(model);
+  camera.SetWidth(width);
+  camera.SetHeight(height);
+  camera.SetParams(params);
+  return camera;
+}
+
+// cam_from_world of a camera at `center` looking along world +x, image x
+// along world -y, image y along world -z, then turned by `yaw` about z.
+Rigid3d LookingAlongX(const Eigen::Vector3d& center, double yaw = 0) {
+  Eigen::Matrix3d world_from_cam;
+  world_from_cam.col(0) = -Eigen::Vector3d::UnitY();
+  world_from_cam.col(1) = -Eigen::Vector3d::UnitZ();
+  world_from_cam.col(2) = Eigen::Vector3d::UnitX();
+  world_from_cam =
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+      world_from_cam;
+  return Rigid3d(world_from_cam, center).Inverse();
+}
+
+RenderOptions GreyNoiseless() {
+  RenderOptions options;
+  options.as_rgb = false;
+  options.noise_stddev = 0;
+  return options;
+}
+
+// The grey levels of a bitmap, row-major.
+std::vector<double> GreyLevels(const colmap::Bitmap& bitmap) {
+  std::vector<double> levels;
+  for (int y = 0; y < bitmap.Height(); ++y) {
+    for (int x = 0; x < bitmap.Width(); ++x) {
+      colmap::BitmapColor<uint8_t> color;
+      bitmap.GetPixel(x, y, &color);
+      levels.push_back(color.r);
+    }
+  }
+  return levels;
+}
+
+// Bilinear interpolation at a point in COLMAP pixel coordinates (pixel
+// (x, y) has its center at (x + 0.5, y + 0.5)).
+double Sample(const std::vector<double>& levels, int width,
+              const Eigen::Vector2d& point) {
+  const double x = point.x() - 0.5;
+  const double y = point.y() - 0.5;
+  const int x0 = static_cast<int>(std::floor(x));
+  const int y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0;
+  const double fy = y - y0;
+  auto at = [&](int u, int v) { return levels[v * width + u]; };
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+         fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+}
+
+double NormalizedCrossCorrelation(const std::vector<double>& a,
+                                  const std::vector<double>& b) {
+  double mean_a = 0, mean_b = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    mean_a += a[k];
+    mean_b += b[k];
+  }
+  mean_a /= a.size();
+  mean_b /= b.size();
+  double ab = 0, aa = 0, bb = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    ab += (a[k] - mean_a) * (b[k] - mean_b);
+    aa += (a[k] - mean_a) * (a[k] - mean_a);
+    bb += (b[k] - mean_b) * (b[k] - mean_b);
+  }
+  return ab / std::sqrt(aa * bb);
+}
+
+TEST(TexturedScene, SceneNamesRoundTrip) {
+  for (const SceneType type : AllSceneTypes()) {
+    SceneType parsed = SceneType::kStreet;
+    ASSERT_TRUE(SceneTypeFromName(SceneTypeName(type), &parsed));
+    EXPECT_EQ(parsed, type);
+  }
+  SceneType parsed = SceneType::kCourtyard;
+  EXPECT_FALSE(SceneTypeFromName("garden", &parsed));
+  EXPECT_EQ(parsed, SceneType::kCourtyard);
+}
+
+TEST(TexturedScene, RaysHitTheRightFaces) {
+  const TexturedScene room = TexturedScene::Make(SceneType::kRoom, 0);
+  SceneHit hit;
+  // Up to the ceiling of the enclosure, seen from inside.
+  ASSERT_TRUE(room.Intersect(Eigen::Vector3d(1, 1, 1.5),
+                             Eigen::Vector3d::UnitZ(), &hit));
+  EXPECT_NEAR(hit.distance, 1.5, 1e-12);
+  EXPECT_NEAR((hit.normal - Eigen::Vector3d(0, 0, -1)).norm(), 0, 1e-12);
+  // Along +y into the pillar's -y face.
+  ASSERT_TRUE(room.Intersect(Eigen::Vector3d(0, -1.5, 1.5),
+                             Eigen::Vector3d::UnitY(), &hit));
+  EXPECT_NEAR(hit.distance, 1.25, 1e-12);
+  EXPECT_NEAR((hit.point - Eigen::Vector3d(0, -0.25, 1.5)).norm(), 0, 1e-12);
+  EXPECT_NEAR((hit.normal - Eigen::Vector3d(0, -1, 0)).norm(), 0, 1e-12);
+  EXPECT_EQ(hit.face, 1 * 6 + 1 * 2 + 0);
+  // Outdoors, straight up is the sky.
+  const TexturedScene street = TexturedScene::Make(SceneType::kStreet, 0);
+  EXPECT_FALSE(street.Intersect(Eigen::Vector3d(0, 0, 1.6),
+                                Eigen::Vector3d::UnitZ(), &hit));
+  EXPECT_TRUE(room.IsFree(Eigen::Vector3d(1, 1, 1.5), 0.3));
+  EXPECT_FALSE(room.IsFree(Eigen::Vector3d(0, 0.4, 1.5), 0.3));  // pillar
+  EXPECT_FALSE(room.IsFree(Eigen::Vector3d(3.9, 0, 1.5), 0.3));  // wall
+}
+
+TEST(TexturedScene, TextureIsFixedInTheSceneAndFilteredByFootprint) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 5);
+  SceneHit hit;
+  ASSERT_TRUE(scene.Intersect(Eigen::Vector3d(1, 1, 1.5),
+                              Eigen::Vector3d::UnitZ(), &hit));
+  // The same point reached from elsewhere has the same texture.
+  SceneHit other;
+  const Eigen::Vector3d origin(0.2, 1.8, 0.5);
+  ASSERT_TRUE(
+      scene.Intersect(origin, (hit.point - origin).normalized(), &other));
+  EXPECT_NEAR((other.point - hit.point).norm(), 0, 1e-9);
+  EXPECT_EQ(scene.Radiance(hit, 0.002), scene.Radiance(other, 0.002));
+  // Fine detail: neighbouring points 1 cm apart differ; with a 1 m footprint
+  // only the coarse octaves remain, so the texture varies much less.
+  double fine_variation = 0, coarse_variation = 0;
+  for (int k = 0; k < 200; ++k) {
+    SceneHit a = hit, b = hit;
+    a.point.x() = -3 + 0.03 * k;
+    b.point.x() = a.point.x() + 0.01;
+    fine_variation +=
+        std::abs(scene.Radiance(a, 0.002) - scene.Radiance(b, 0.002));
+    coarse_variation +=
+        std::abs(scene.Radiance(a, 1.0) - scene.Radiance(b, 1.0));
+  }
+  EXPECT_GT(fine_variation / 200, 0.02);
+  EXPECT_LT(coarse_variation, 0.2 * fine_variation);
+  // A different seed gives a different texture.
+  const TexturedScene reseeded = TexturedScene::Make(SceneType::kRoom, 6);
+  EXPECT_NE(scene.Radiance(hit, 0.002), reseeded.Radiance(hit, 0.002));
+}
+
+TEST(SceneRenderer, RenderingIsDeterministic) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 1);
+  const colmap::Camera camera =
+      MakeCamera("OPENCV", 160, 120, {110, 112, 81, 59, -0.2, 0.05, 0, 0});
+  const Rigid3d cam_from_world = LookingAlongX(Eigen::Vector3d(1, -1, 1.5));
+  RenderOptions options;  // RGB with noise
+  const colmap::Bitmap first =
+      RenderImage(scene, camera, cam_from_world, options, 42);
+  const colmap::Bitmap second =
+      RenderImage(scene, camera, cam_from_world, options, 42);
+  ASSERT_EQ(first.Width(), 160);
+  ASSERT_EQ(first.Height(), 120);
+  ASSERT_TRUE(first.IsRGB());
+  EXPECT_EQ(first.ConvertToRowMajorArray(), second.ConvertToRowMajorArray());
+  const colmap::Bitmap other_noise =
+      RenderImage(scene, camera, cam_from_world, options, 43);
+  EXPECT_NE(first.ConvertToRowMajorArray(),
+            other_noise.ConvertToRowMajorArray());
+  options.supersampling = 0;
+  EXPECT_EQ(RenderImage(scene, camera, cam_from_world, options, 42).Width(), 0);
+}
+
+// A point of the scene appears where COLMAP's camera model projects it: the
+// patch around the point's projection in a pinhole view matches, after the
+// local affine map between the views, the patch around its projection in a
+// strongly distorted view, at a shift below a quarter pixel.
+TEST(SceneRenderer, ScenePointsAppearWhereTheCameraModelProjectsThem) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 3);
+  const Eigen::Vector3d point(3.9, -0.3, 1.5);  // on the east wall panel
+  const colmap::Camera pinhole =
+      MakeCamera("PINHOLE", 320, 240, {250, 250, 160, 120});
+  const Rigid3d pinhole_from_world =
+      LookingAlongX(Eigen::Vector3d(1.5, -0.3, 1.5));
+  const colmap::Camera distorted = MakeCamera(
+      "OPENCV", 640, 480, {420, 415, 330, 236, -0.3, 0.08, 0.001, -0.0005});
+  const Rigid3d distorted_from_world =
+      LookingAlongX(Eigen::Vector3d(1.5, 1.0, 1.8), 0.05);
+  auto project = [&](const colmap::Camera& camera, const Rigid3d& pose,
+                     const Eigen::Vector3d& world) {
+    return camera.WorldToImage((pose * world).hnormalized());
+  };
+  const Eigen::Vector2d in_pinhole =
+      project(pinhole, pinhole_from_world, point);
+  const Eigen::Vector2d in_distorted =
+      project(distorted, distorted_from_world, point);
+  // Far from the distorted camera's center, where distortion moves points by
+  // many pixels.
+  ASSERT_GT((in_distorted - Eigen::Vector2d(330, 236)).norm(), 180);
+  const Eigen::Vector2d undistorted =
+      Eigen::Vector2d(420, 415).cwiseProduct(
+          distorted.ImageToWorld(in_distorted)) +
+      Eigen::Vector2d(330, 236);
+  ASSERT_GT((undistorted - in_distorted).norm(), 10);
+
+  // The local affine map from pinhole to distorted pixels, through the wall
+  // plane x = 3.9: pinhole pixel -> ray -> wall point -> distorted pixel.
+  auto to_distorted = [&](const Eigen::Vector2d& pinhole_pixel) {
+    const Eigen::Vector3d ray_in_world =
+        pinhole_from_world.rotation.conjugate() *
+        pinhole.ImageToWorld(pinhole_pixel).homogeneous();
+    const Eigen::Vector3d center = pinhole_from_world.Center();
+    const double t = (point.x() - center.x()) / ray_in_world.x();
+    return project(distorted, distorted_from_world, center + t * ray_in_world);
+  };
+
+  const colmap::Bitmap pinhole_image =
+      RenderImage(scene, pinhole, pinhole_from_world, GreyNoiseless(), 0);
+  const colmap::Bitmap distorted_image =
+      RenderImage(scene, distorted, distorted_from_world, GreyNoiseless(), 0);
+  const std::vector<double> pinhole_levels = GreyLevels(pinhole_image);
+  const std::vector<double> distorted_levels = GreyLevels(distorted_image);
+
+  constexpr int kRadius = 12;
+  std::vector<double> reference;
+  std::vector<Eigen::Vector2d> mapped;
+  for (int dy = -kRadius; dy <= kRadius; ++dy) {
+    for (int dx = -kRadius; dx <= kRadius; ++dx) {
+      const Eigen::Vector2d pixel = in_pinhole + Eigen::Vector2d(dx, dy);
+      reference.push_back(Sample(pinhole_levels, 320, pixel));
+      mapped.push_back(to_distorted(pixel));
+    }
+  }
+  double best_score = -2;
+  Eigen::Vector2d best_shift = Eigen::Vector2d::Zero();
+  for (double sy = -2; sy <= 2; sy += 0.125) {
+    for (double sx = -2; sx <= 2; sx += 0.125) {
+      std::vector<double> candidate;
+      for (const Eigen::Vector2d& p : mapped) {
+        candidate.push_back(
+            Sample(distorted_levels, 640, p + Eigen::Vector2d(sx, sy)));
+      }
+      const double score = NormalizedCrossCorrelation(reference, candidate);
+      if (score > best_score) {
+        best_score = score;
+        best_shift = Eigen::Vector2d(sx, sy);
+      }
+    }
+  }
+  std::cout << "patch match: NCC " << best_score << " at a shift of "
+            << best_shift.transpose() << " px" << std::endl;
+  EXPECT_GT(best_score, 0.85);
+  EXPECT_LE(best_shift.norm(), 0.25) << best_shift.transpose();
+}
+
+TEST(SceneRenderer, FisheyeRaysAreFiniteAndBeyondNinetyDegreesAreBlack) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 2);
+  const Rigid3d cam_from_world = LookingAlongX(Eigen::Vector3d(0, -1.5, 1.5));
+  // The helmet preset's fisheye (about 150 degrees diagonally): every pixel
+  // has a ray.
+  const colmap::Camera helmet =
+      MakeRigPreset(RigPreset::kFisheyeHelmet5).cameras[0];
+  const CameraRays helmet_rays(helmet, 1);
+  EXPECT_EQ(helmet_rays.NumMaskedPixels(), 0);
+  // A fisheye whose corners are 150 degrees off axis: the corners have no
+  // ray (COLMAP 3.8's model cannot represent them) and must be black, and
+  // the rest must be finite, unit rays.
+  const colmap::Camera wide =
+      MakeCamera("OPENCV_FISHEYE", 200, 150, {48, 48, 100, 75, 0, 0, 0, 0});
+  const CameraRays wide_rays(wide, 2);
+  EXPECT_GT(wide_rays.NumMaskedPixels(), 100);
+  EXPECT_LT(wide_rays.NumMaskedPixels(), 200 * 150 / 2);
+  int num_valid = 0;
+  for (int y = 0; y < 150; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      ASSERT_TRUE(std::isfinite(wide_rays.PixelAngle(x, y)));
+      for (int s = 0; s < wide_rays.NumSamples(); ++s) {
+        const Eigen::Vector3f& ray = wide_rays.Ray(x, y, s);
+        ASSERT_TRUE(ray.allFinite());
+        if (!ray.isZero()) {
+          EXPECT_NEAR(ray.norm(), 1, 1e-6);
+          EXPECT_GT(ray.z(), 0);
+          ++num_valid;
+        }
+      }
+    }
+  }
+  EXPECT_GT(num_valid, 200 * 150 * 4 / 2);
+  const colmap::Bitmap image =
+      RenderImage(scene, wide, cam_from_world, GreyNoiseless(), 0);
+  colmap::BitmapColor<uint8_t> corner, center;
+  ASSERT_TRUE(image.GetPixel(0, 0, &corner));
+  ASSERT_TRUE(image.GetPixel(100, 75, &center));
+  EXPECT_EQ(corner.r, 0);
+  EXPECT_GT(center.r, 0);
+}
+
+// The real component: COLMAP's CPU SIFT finds over 1000 features in a
+// rendered 640 x 480 image of every scene (a map view of each).
+TEST(SceneRenderer, SiftFindsThousandsOfFeatures) {
+  colmap::SiftExtractionOptions sift_options;
+  sift_options.use_gpu = false;
+  sift_options.num_threads = 1;
+  for (const SceneType type : AllSceneTypes()) {
+    RenderedDatasetOptions options;
+    options.scene = type;
+    options.num_map_images = 8;
+    options.num_framesets = 1;
+    RenderedDatasetPlan plan;
+    std::string error;
+    ASSERT_TRUE(PlanRenderedDataset(options, &plan, &error)) << error;
+    auto start = std::chrono::steady_clock::now();
+    const colmap::Bitmap image =
+        RenderImage(plan.scene, plan.map_camera, plan.map_cam_from_world[1],
+                    RenderOptions(), 0);
+    const double render_seconds = SecondsSince(start);
+    start = std::chrono::steady_clock::now();
+    colmap::FeatureKeypoints keypoints;
+    colmap::FeatureDescriptors descriptors;
+    ASSERT_TRUE(colmap::ExtractSiftFeaturesCPU(
+        sift_options, image.CloneAsGrey(), &keypoints, &descriptors));
+    std::cout << SceneTypeName(type) << ": rendered 640x480 in "
+              << render_seconds << " s, " << keypoints.size()
+              << " SIFT features in " << SecondsSince(start) << " s"
+              << std::endl;
+    EXPECT_GT(keypoints.size(), 1000u) << SceneTypeName(type);
+  }
+}
+
+}  // namespace
+}  // namespace rig_calibrator
