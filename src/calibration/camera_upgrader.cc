@@ -2,8 +2,7 @@
 
 #include <ceres/ceres.h>
 #include <colmap/base/camera_models.h>
-#include <colmap/optim/loransac.h>
-#include <colmap/optim/sampler.h>
+#include <colmap/util/math.h>
 #include <colmap/util/threading.h>
 #include <glog/logging.h>
 
@@ -11,10 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <random>
 
-#include "src/solvers/intrinsics_solvers.h"
+#include "src/estimators/radial_intrinsics_estimator.h"
 
 namespace rig_calibrator {
 namespace {
@@ -55,77 +53,6 @@ bool InitializationForModel(const int model_id, Initialization* init) {
       return true;
     default:
       return false;
-  }
-}
-
-// colmap::RandomSampler draws from COLMAP's thread-local generator, whose
-// state depends on whatever ran before on the thread (the pipeline upgrades
-// cameras on a thread pool). This one has its own generator with a fixed
-// seed, so the upgrade depends only on its input.
-class SeededRandomSampler : public colmap::Sampler {
- public:
-  explicit SeededRandomSampler(const size_t num_samples)
-      : num_samples_(num_samples) {}
-
-  void Initialize(const size_t total_num_samples) override {
-    CHECK_LE(num_samples_, total_num_samples);
-    indices_.resize(total_num_samples);
-    std::iota(indices_.begin(), indices_.end(), 0);
-  }
-
-  size_t MaxNumSamples() override { return std::numeric_limits<size_t>::max(); }
-
-  // Partial Fisher-Yates shuffle: the first num_samples_ indices.
-  std::vector<size_t> Sample() override {
-    for (size_t i = 0; i < num_samples_; ++i) {
-      std::uniform_int_distribution<size_t> distribution(i,
-                                                         indices_.size() - 1);
-      std::swap(indices_[i], indices_[distribution(generator_)]);
-    }
-    return {indices_.begin(), indices_.begin() + num_samples_};
-  }
-
- private:
-  const size_t num_samples_;
-  std::vector<size_t> indices_;
-  std::mt19937 generator_{0};
-};
-
-template <int kNumRadialTerms>
-bool RunInitializationRansac(const colmap::RANSACOptions& ransac_options,
-                             const RadialProfile profile,
-                             const std::vector<Eigen::Vector2d>& x,
-                             const std::vector<Eigen::Vector3d>& points_cam,
-                             RadialIntrinsics* model) {
-  using Estimator = RadialIntrinsicsEstimator<kNumRadialTerms>;
-  colmap::LORANSAC<Estimator, Estimator, colmap::InlierSupportMeasurer,
-                   SeededRandomSampler>
-      ransac(ransac_options);
-  ransac.estimator.profile = profile;
-  ransac.local_estimator.profile = profile;
-  const auto report = ransac.Estimate(x, points_cam);
-  if (!report.success) {
-    return false;
-  }
-  *model = report.model;
-  return true;
-}
-
-bool EstimateInitialIntrinsics(const colmap::RANSACOptions& ransac_options,
-                               const Initialization& init,
-                               const std::vector<Eigen::Vector2d>& x,
-                               const std::vector<Eigen::Vector3d>& points_cam,
-                               RadialIntrinsics* model) {
-  switch (init.num_radial_terms) {
-    case 0:
-      return RunInitializationRansac<0>(ransac_options, init.profile, x,
-                                        points_cam, model);
-    case 1:
-      return RunInitializationRansac<1>(ransac_options, init.profile, x,
-                                        points_cam, model);
-    default:
-      return RunInitializationRansac<2>(ransac_options, init.profile, x,
-                                        points_cam, model);
   }
 }
 
@@ -283,6 +210,91 @@ int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
   return num_inliers;
 }
 
+// The parameters the LM refines: parameter index -> tangent index (-1 for a
+// fixed principal point coordinate), and the tangent indices of the focal
+// lengths.
+struct RefinedParams {
+  std::vector<int> tangent_idxs;
+  std::vector<int> focal_tangent_idxs;
+  int num_tangent_params = 0;
+};
+
+template <typename CameraModel>
+RefinedParams RefinedParamsOfModel(const CameraUpgradeOptions& options) {
+  const std::vector<size_t>& principal_point_idxs =
+      CameraModel::principal_point_idxs;
+  RefinedParams refined;
+  for (size_t i = 0; i < CameraModel::kNumParams; ++i) {
+    const bool fixed = !options.refine_principal_point &&
+                       std::count(principal_point_idxs.begin(),
+                                  principal_point_idxs.end(), i) > 0;
+    refined.tangent_idxs.push_back(fixed ? -1 : refined.num_tangent_params++);
+  }
+  for (const size_t i : CameraModel::focal_length_idxs) {
+    refined.focal_tangent_idxs.push_back(refined.tangent_idxs[i]);
+  }
+  return refined;
+}
+
+// The LM problem of one refinement round: tz and the model's parameters (the
+// principal point fixed unless refined), a Cauchy-robustified full
+// reprojection residual per inlier.
+template <typename CameraModel>
+void BuildRefinementProblem(const CameraUpgradeOptions& options,
+                            const std::vector<Eigen::Vector2d>& points2D,
+                            const std::vector<Eigen::Vector3d>& points_cam,
+                            const std::vector<char>& inlier_mask, double* tz,
+                            std::vector<double>* params,
+                            ceres::Problem* problem,
+                            std::vector<ceres::ResidualBlockId>* blocks) {
+  problem->AddParameterBlock(tz, 1);
+  problem->AddParameterBlock(params->data(), CameraModel::kNumParams);
+  if (!options.refine_principal_point) {
+    const std::vector<size_t>& idxs = CameraModel::principal_point_idxs;
+    problem->SetManifold(
+        params->data(),
+        new ceres::SubsetManifold(CameraModel::kNumParams,
+                                  std::vector<int>(idxs.begin(), idxs.end())));
+  }
+  ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
+  blocks->clear();
+  for (size_t i = 0; i < points2D.size(); ++i) {
+    if (inlier_mask[i]) {
+      blocks->push_back(problem->AddResidualBlock(
+          FullReprojectionCost<CameraModel>::Create(points2D[i], points_cam[i]),
+          loss, tz, params->data()));
+    }
+  }
+}
+
+// The conditioning fields of `result` from the final round's problem.
+template <typename CameraModel>
+void SetConditioning(const ceres::Problem& problem,
+                     const std::vector<ceres::ResidualBlockId>& blocks,
+                     const RefinedParams& refined,
+                     const std::vector<Eigen::Vector3d>& points_cam,
+                     const double tz, const std::vector<double>& params,
+                     CameraUpgradeResult* result) {
+  const Conditioning conditioning = ComputeConditioning(
+      problem, blocks, refined.focal_tangent_idxs, refined.num_tangent_params);
+  double mean_focal = 0;
+  for (const size_t i : CameraModel::focal_length_idxs) {
+    mean_focal += params[i] / CameraModel::focal_length_idxs.size();
+  }
+  std::vector<double> depths;
+  for (size_t i = 0; i < points_cam.size(); ++i) {
+    if (result->inlier_mask[i]) depths.push_back(points_cam[i].z() + tz);
+  }
+  const double median_depth = depths.empty() ? 0 : colmap::Median(depths);
+  result->tz_focal_correlation = conditioning.tz_focal_correlation;
+  result->tz_stddev_at_1px = std::sqrt(conditioning.tz_variance);
+  result->focal_stddev_at_1px = std::sqrt(conditioning.focal_variance);
+  result->well_conditioned =
+      !conditioning.singular &&
+      result->focal_stddev_at_1px <= kMaxRelativeStddevAt1px * mean_focal &&
+      result->tz_stddev_at_1px <= kMaxRelativeStddevAt1px * median_depth;
+}
+
 // Step 3: LM over tz and the model's parameters on the inliers, inliers
 // re-evaluated on all points, repeated while they change.
 template <typename CameraModel>
@@ -291,22 +303,8 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
                    const std::vector<Eigen::Vector3d>& points_cam,
                    const std::vector<char>& valid, double* tz,
                    std::vector<double>* params, CameraUpgradeResult* result) {
-  const std::vector<size_t>& focal_idxs = CameraModel::focal_length_idxs;
-  const std::vector<size_t>& principal_point_idxs =
-      CameraModel::principal_point_idxs;
-  std::vector<int> tangent_idxs;  // parameter index -> tangent index or -1
-  int num_tangent_params = 0;
-  for (size_t i = 0; i < CameraModel::kNumParams; ++i) {
-    const bool fixed = !options.refine_principal_point &&
-                       std::count(principal_point_idxs.begin(),
-                                  principal_point_idxs.end(), i) > 0;
-    tangent_idxs.push_back(fixed ? -1 : num_tangent_params++);
-  }
-  std::vector<int> focal_tangent_idxs;
-  for (const size_t i : focal_idxs) {
-    focal_tangent_idxs.push_back(tangent_idxs[i]);
-  }
-  const int num_unknowns = 1 + num_tangent_params;
+  const RefinedParams refined = RefinedParamsOfModel<CameraModel>(options);
+  const int num_unknowns = 1 + refined.num_tangent_params;
 
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
@@ -331,26 +329,10 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
       return false;
     }
     ceres::Problem problem;
-    problem.AddParameterBlock(&refined_tz, 1);
-    problem.AddParameterBlock(refined_params.data(), CameraModel::kNumParams);
-    if (!options.refine_principal_point) {
-      problem.SetManifold(refined_params.data(),
-                          new ceres::SubsetManifold(
-                              CameraModel::kNumParams,
-                              std::vector<int>(principal_point_idxs.begin(),
-                                               principal_point_idxs.end())));
-    }
-    ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
     std::vector<ceres::ResidualBlockId> residual_blocks;
-    residual_blocks.reserve(num_inliers);
-    for (size_t i = 0; i < points2D.size(); ++i) {
-      if (inlier_mask[i]) {
-        residual_blocks.push_back(
-            problem.AddResidualBlock(FullReprojectionCost<CameraModel>::Create(
-                                         points2D[i], points_cam[i]),
-                                     loss, &refined_tz, refined_params.data()));
-      }
-    }
+    BuildRefinementProblem<CameraModel>(
+        options, points2D, points_cam, inlier_mask, &refined_tz,
+        &refined_params, &problem, &residual_blocks);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     if (!summary.IsSolutionUsable() || !std::isfinite(refined_tz) ||
@@ -365,35 +347,16 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
         points2D, points_cam, valid, refined_tz, refined_params,
         options.max_error_px, &inlier_mask, &result->rms_px);
     if (inlier_mask == previous_mask || round + 1 == kMaxNumRefinementRounds) {
-      const Conditioning conditioning = ComputeConditioning(
-          problem, residual_blocks, focal_tangent_idxs, num_tangent_params);
-      double mean_focal = 0;
-      for (const size_t i : focal_idxs) {
-        mean_focal += refined_params[i] / focal_idxs.size();
-      }
-      std::vector<double> depths;
-      for (size_t i = 0; i < points_cam.size(); ++i) {
-        if (inlier_mask[i]) depths.push_back(points_cam[i].z() + refined_tz);
-      }
-      std::nth_element(depths.begin(), depths.begin() + depths.size() / 2,
-                       depths.end());
-      const double median_depth =
-          depths.empty() ? 0 : depths[depths.size() / 2];
-      result->tz_focal_correlation = conditioning.tz_focal_correlation;
-      result->tz_stddev_at_1px = std::sqrt(conditioning.tz_variance);
-      result->focal_stddev_at_1px = std::sqrt(conditioning.focal_variance);
-      result->well_conditioned =
-          !conditioning.singular &&
-          result->focal_stddev_at_1px <= kMaxRelativeStddevAt1px * mean_focal &&
-          result->tz_stddev_at_1px <= kMaxRelativeStddevAt1px * median_depth;
+      SetConditioning<CameraModel>(problem, residual_blocks, refined,
+                                   points_cam, refined_tz, refined_params,
+                                   result);
       break;
     }
   }
-  for (const size_t i : focal_idxs) {
+  for (const size_t i : CameraModel::focal_length_idxs) {
     if (!(refined_params[i] > 0)) {
       result->error_message =
-          "the refinement produced a non-positive focal "
-          "length";
+          "the refinement produced a non-positive focal length";
       return false;
     }
   }
@@ -453,6 +416,94 @@ std::string CheckOptions(const CameraUpgradeOptions& options) {
   return "";
 }
 
+// Why the upgrade cannot start ("" if it can); fills `init` for the model.
+std::string CheckInput(const CameraUpgradeOptions& options,
+                       const std::vector<Eigen::Vector2d>& points2D,
+                       const std::vector<Eigen::Vector3d>& points_cam,
+                       const colmap::Camera& camera, Initialization* init) {
+  const std::string options_error = CheckOptions(options);
+  if (!options_error.empty()) {
+    return "invalid options: " + options_error;
+  }
+  if (points2D.size() != points_cam.size()) {
+    return std::to_string(points2D.size()) + " 2D points but " +
+           std::to_string(points_cam.size()) + " 3D points";
+  }
+  if (!InitializationForModel(camera.ModelId(), init)) {
+    const std::string name = colmap::CameraModelIdToName(camera.ModelId());
+    return "camera model " +
+           (name.empty() ? "id " + std::to_string(camera.ModelId()) : name) +
+           " is not supported (supported: SIMPLE_PINHOLE, PINHOLE, "
+           "SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, "
+           "SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE, OPENCV_FISHEYE, "
+           "THIN_PRISM_FISHEYE)";
+  }
+  if (!camera.VerifyParams()) {
+    return "camera has " + std::to_string(camera.NumParams()) +
+           " parameters, model " + camera.ModelName() + " needs " +
+           std::to_string(colmap::CameraModelNumParams(camera.ModelId()));
+  }
+  if (!Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY())
+           .allFinite()) {
+    return "the principal point is not finite";
+  }
+  return "";
+}
+
+// Step 1 on at most max_num_ransac_points of the valid correspondences, drawn
+// with a fixed seed, with pixels relative to the principal point.
+bool EstimateInitialization(const CameraUpgradeOptions& options,
+                            const Initialization& init,
+                            const std::vector<Eigen::Vector2d>& points2D,
+                            const std::vector<Eigen::Vector3d>& points_cam,
+                            const Eigen::Vector2d& principal_point,
+                            std::vector<size_t> valid_idxs,
+                            RadialIntrinsics* initial, std::string* error) {
+  if (valid_idxs.size() > static_cast<size_t>(options.max_num_ransac_points)) {
+    std::mt19937 generator(0);
+    std::shuffle(valid_idxs.begin(), valid_idxs.end(), generator);
+    valid_idxs.resize(options.max_num_ransac_points);
+  }
+  std::vector<Eigen::Vector2d> ransac_x;
+  std::vector<Eigen::Vector3d> ransac_points_cam;
+  for (const size_t i : valid_idxs) {
+    ransac_x.push_back(points2D[i] - principal_point);
+    ransac_points_cam.push_back(points_cam[i]);
+  }
+  colmap::RANSACOptions ransac_options;
+  ransac_options.max_error = options.max_error_px;
+  ransac_options.confidence = options.confidence;
+  ransac_options.min_num_trials = options.min_num_trials;
+  ransac_options.max_num_trials = options.max_num_trials;
+  if (!EstimateRadialIntrinsicsRansac(ransac_options, init.profile,
+                                      init.num_radial_terms, ransac_x,
+                                      ransac_points_cam, initial)) {
+    *error = "no initial tz and focal length consistent with " +
+             std::to_string(init.num_radial_terms + 3) + " or more of the " +
+             std::to_string(valid_idxs.size()) + " correspondences";
+    return false;
+  }
+  return true;
+}
+
+// Step 2: the model's parameters from the initialization: fx = fy = f, the
+// principal point, k1, k2 where the model has them, every other term 0.
+std::vector<double> InitialParams(const colmap::Camera& camera,
+                                  const Initialization& init,
+                                  const RadialIntrinsics& initial,
+                                  const Eigen::Vector2d& principal_point) {
+  std::vector<double> params(camera.NumParams(), 0.0);
+  for (const size_t i : camera.FocalLengthIdxs()) {
+    params[i] = initial.focal;
+  }
+  params[camera.PrincipalPointIdxs()[0]] = principal_point.x();
+  params[camera.PrincipalPointIdxs()[1]] = principal_point.y();
+  for (int j = 0; j < init.num_radial_terms; ++j) {
+    params[camera.ExtraParamsIdxs()[j]] = initial.k[j];
+  }
+  return params;
+}
+
 bool Fail(const std::string& message, CameraUpgradeResult* result) {
   result->error_message = message;
   LOG(ERROR) << "Camera upgrade: " << message;
@@ -475,41 +526,15 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
     return false;
   }
   *result = CameraUpgradeResult();
-  const std::string options_error = CheckOptions(options);
-  if (!options_error.empty()) {
-    return Fail("invalid options: " + options_error, result);
-  }
-  if (points2D.size() != points_cam.size()) {
-    return Fail(std::to_string(points2D.size()) + " 2D points but " +
-                    std::to_string(points_cam.size()) + " 3D points",
-                result);
-  }
   Initialization init;
-  if (!InitializationForModel(camera->ModelId(), &init)) {
-    const std::string name = colmap::CameraModelIdToName(camera->ModelId());
-    return Fail(
-        "camera model " +
-            (name.empty() ? "id " + std::to_string(camera->ModelId()) : name) +
-            " is not supported (supported: SIMPLE_PINHOLE, PINHOLE, "
-            "SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, "
-            "SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE, OPENCV_FISHEYE, "
-            "THIN_PRISM_FISHEYE)",
-        result);
-  }
-  if (!camera->VerifyParams()) {
-    return Fail(
-        "camera has " + std::to_string(camera->NumParams()) +
-            " parameters, model " + camera->ModelName() + " needs " +
-            std::to_string(colmap::CameraModelNumParams(camera->ModelId())),
-        result);
+  const std::string input_error =
+      CheckInput(options, points2D, points_cam, *camera, &init);
+  if (!input_error.empty()) {
+    return Fail(input_error, result);
   }
   const Eigen::Vector2d principal_point(camera->PrincipalPointX(),
                                         camera->PrincipalPointY());
-  if (!principal_point.allFinite()) {
-    return Fail("the principal point is not finite", result);
-  }
 
-  // Valid correspondences, with pixels relative to the principal point.
   const size_t num_points = points2D.size();
   std::vector<char> valid(num_points, 0);
   std::vector<size_t> valid_idxs;
@@ -527,32 +552,11 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
                 result);
   }
 
-  // Step 1 on at most max_num_ransac_points of them, drawn with a fixed seed.
-  std::vector<size_t> ransac_idxs = valid_idxs;
-  if (ransac_idxs.size() > static_cast<size_t>(options.max_num_ransac_points)) {
-    std::mt19937 generator(0);
-    std::shuffle(ransac_idxs.begin(), ransac_idxs.end(), generator);
-    ransac_idxs.resize(options.max_num_ransac_points);
-  }
-  std::vector<Eigen::Vector2d> ransac_x;
-  std::vector<Eigen::Vector3d> ransac_points_cam;
-  for (const size_t i : ransac_idxs) {
-    ransac_x.push_back(points2D[i] - principal_point);
-    ransac_points_cam.push_back(points_cam[i]);
-  }
-  colmap::RANSACOptions ransac_options;
-  ransac_options.max_error = options.max_error_px;
-  ransac_options.confidence = options.confidence;
-  ransac_options.min_num_trials = options.min_num_trials;
-  ransac_options.max_num_trials = options.max_num_trials;
   RadialIntrinsics initial;
-  if (!EstimateInitialIntrinsics(ransac_options, init, ransac_x,
-                                 ransac_points_cam, &initial)) {
-    return Fail("no initial tz and focal length consistent with " +
-                    std::to_string(init.num_radial_terms + 3) +
-                    " or more of the " + std::to_string(ransac_idxs.size()) +
-                    " correspondences",
-                result);
+  if (!EstimateInitialization(options, init, points2D, points_cam,
+                              principal_point, valid_idxs, &initial,
+                              &result->error_message)) {
+    return Fail(result->error_message, result);
   }
   result->inlier_mask.assign(num_points, 0);
   const double max_squared_error = options.max_error_px * options.max_error_px;
@@ -564,18 +568,8 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
             max_squared_error;
   }
 
-  // Step 2: the model's parameters from the initialization.
-  std::vector<double> params(camera->NumParams(), 0.0);
-  for (const size_t i : camera->FocalLengthIdxs()) {
-    params[i] = initial.focal;
-  }
-  params[camera->PrincipalPointIdxs()[0]] = principal_point.x();
-  params[camera->PrincipalPointIdxs()[1]] = principal_point.y();
-  for (int j = 0; j < init.num_radial_terms; ++j) {
-    params[camera->ExtraParamsIdxs()[j]] = initial.k[j];
-  }
-
-  // Step 3.
+  std::vector<double> params =
+      InitialParams(*camera, init, initial, principal_point);
   double tz = initial.tz;
   if (!RefineUpgradeForModel(camera->ModelId(), options, points2D, points_cam,
                              valid, &tz, &params, result)) {

@@ -3,12 +3,14 @@
 // correspondences, estimate the forward translation tz and all intrinsics of
 // a COLMAP camera model.
 //
-//  1. LO-RANSAC (COLMAP's LORANSAC) with RadialIntrinsicsEstimator
-//     (intrinsics_solvers.h): division-model linear solve for tz, then
-//     variable projection over tz for the target model's radial profile
-//     (polynomial for the perspective models, equidistant for the fisheye
-//     ones) with f and the first two radial terms. Residual: full
-//     reprojection error, principal point fixed at the input estimate.
+//  1. LO-RANSAC (EstimateRadialIntrinsicsRansac,
+//     src/estimators/radial_intrinsics_estimator.h) for the target model's
+//     radial profile (polynomial for the perspective models, equidistant for
+//     the fisheye ones) with f and the first two radial terms: hypotheses
+//     from the minimal solver (SolveMinimalRadialIntrinsics, closed form),
+//     local optimization by variable projection over tz
+//     (SolveRadialIntrinsicsLeastSquares). Residual: full reprojection
+//     error, principal point fixed at the input estimate.
 //  2. Conversion to the model's parameters: fx = fy = f, k1, k2 where the
 //     model has them, every other distortion term 0.
 //  3. Levenberg-Marquardt (Ceres, Cauchy loss) over tz and all parameters of

@@ -1,0 +1,57 @@
+// Minimal solver for tz, the focal length and radial distortion of a camera
+// whose 1D radial pose (R, tx, ty) is known (paper §3.5, MATH.md §3; the
+// polynomial case is Larsson et al. ICCV'19's D(n, 0) with the pose known).
+// The minimal estimator of the upgrade's LO-RANSAC
+// (radial_intrinsics_estimator.h). Notation: radial_intrinsics.h.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "src/solvers/radial_intrinsics.h"
+
+namespace rig_calibrator {
+
+// Problem: tz, f and the first n = num_radial_terms (0..2) distortion terms
+// of `profile` from exactly n + 2 correspondences (n + 2 unknowns).
+//
+// Method: for a fixed tz the profile is linear in y = [f, f k1, .., f kn],
+//   rho_i = sum_j y_j phi_i^(2j+1),   phi_i = ProfileAngle(s_i, c_i + tz),
+// so the (n+2)x(n+2) matrix M(tz) with rows [phi_i, phi_i^3, ..,
+// phi_i^(2n+1), -rho_i] has the null vector [y; 1]: det M(tz) = 0 at every
+// solution.
+//  - Polynomial profile, phi_i = s_i / d_i with d_i = c_i + tz: row i times
+//    d_i^(2n+1) is [s_i d_i^(2n), s_i^3 d_i^(2n-2), .., s_i^(2n+1),
+//    -rho_i d_i^(2n+1)], polynomial in tz, so det is a polynomial of degree
+//    sum_j (2n - 2j) + 2n + 1 = n^2 + 3n + 1, i.e. 1, 5 or 11. Its
+//    coefficients are expanded exactly (cofactor expansion on coefficient
+//    vectors) in the variable v = (tz + mean(c)) / L, with L the RMS of
+//    (s_i, c_i - mean(c)) and rho scaled to unit RMS, so that they are of
+//    order 1; its real roots come from the companion matrix
+//    (colmap::FindPolynomialRootsCompanionMatrix).
+//  - Equidistant profile, phi_i = atan2(s_i, d_i): det M(tz) is not
+//    algebraic in tz, so there is no closed form. It is a smooth function
+//    that changes sign at each (simple) solution, unlike the variable
+//    projection's E(tz) >= 0 that only touches zero there, so the solutions
+//    are bracketed by a scan of its sign over the depth of the nearest point
+//    D = tz + min(c) in (0, inf), sampled uniformly in w = (2/pi) atan(D / L)
+//    in (0, 1) (kNumEquidistantScanSteps in the .cc), and each bracket is
+//    solved by TOMS 748 (Boost). Where |det| has a local minimum between
+//    samples of equal sign, a pair of close roots is looked for by Brent's
+//    minimization of |det| there.
+// Every root is then made a solution: y by least squares at that tz
+// (FitRadialProfile), tz and y polished together by Newton
+// (RefineRadialProfileAndTz, quadratic on these square systems), kept if the
+// residuals vanish (1e-6 of the RMS radius), every c_i + tz > 0, f > 0 and
+// r_d grows with the ray angle over the points (RadiusGrowsOverPoints).
+//
+// Solutions: polynomial at most 1, 5, 11 for n = 0, 1, 2 (the degree);
+// equidistant at most one per scan step, in practice as many as the
+// polynomial case. Order: increasing tz. Degenerate samples (rank-deficient
+// M, points on the principal point, non-finite values) give none.
+std::vector<RadialIntrinsics> SolveMinimalRadialIntrinsics(
+    const std::vector<Eigen::Vector2d>& x,
+    const std::vector<Eigen::Vector3d>& points_cam, RadialProfile profile,
+    int num_radial_terms);
+
+}  // namespace rig_calibrator

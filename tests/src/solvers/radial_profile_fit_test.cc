@@ -1,0 +1,100 @@
+#include "src/solvers/radial_profile_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "tests/src/solvers/radial_intrinsics_scene.h"
+
+namespace rig_calibrator {
+namespace {
+
+using testing::MakeRadialIntrinsics;
+using testing::MakeRadialIntrinsicsScene;
+using testing::RadialIntrinsicsScene;
+using testing::RelativeError;
+
+RadialIntrinsics Truth(const RadialProfile profile) {
+  return profile == RadialProfile::kPolynomial
+             ? MakeRadialIntrinsics(profile, 2, 1.3, 500, -0.3, 0.08)
+             : MakeRadialIntrinsics(profile, 2, 1.3, 300, 0.03, -0.005);
+}
+
+TEST(FitRadialProfile, ExactAtTheTrueTz) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    const RadialIntrinsics truth = Truth(profile);
+    const RadialIntrinsicsScene scene =
+        MakeRadialIntrinsicsScene(truth, 100, 45, 5);
+    RadialIntrinsics model = truth;
+    model.focal = 1;
+    model.k[0] = model.k[1] = 0;
+    double squared_error = -1;
+    ASSERT_TRUE(
+        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
+    EXPECT_LT(squared_error, 1e-16);
+    // Any other tz fits worse.
+    model.tz = truth.tz + 0.1;
+    ASSERT_TRUE(
+        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    EXPECT_GT(squared_error, 1);
+    // Points behind the camera.
+    model.tz = -100;
+    EXPECT_FALSE(
+        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  }
+}
+
+// Fewer terms than the truth leave a residual; the terms beyond
+// num_radial_terms are 0.
+TEST(FitRadialProfile, OnlyTheRequestedTerms) {
+  const RadialIntrinsics truth = Truth(RadialProfile::kPolynomial);
+  const RadialIntrinsicsScene scene =
+      MakeRadialIntrinsicsScene(truth, 100, 45, 6);
+  RadialIntrinsics model = truth;
+  model.num_radial_terms = 1;
+  double squared_error = 0;
+  ASSERT_TRUE(
+      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  EXPECT_EQ(model.k[1], 0);
+  EXPECT_GT(squared_error, 1);
+  model.num_radial_terms = 3;
+  EXPECT_FALSE(
+      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+}
+
+// From tz 0.3 m off the truth, Gauss-Newton reaches the truth on exact data
+// and the least-squares optimum on noisy data (a lower error than at the
+// true tz, with the truth within the noise).
+TEST(RefineRadialProfileAndTz, ConvergesFromAWrongTz) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    const RadialIntrinsics truth = Truth(profile);
+    RadialIntrinsicsScene scene = MakeRadialIntrinsicsScene(truth, 200, 45, 7);
+    RadialIntrinsics model = truth;
+    model.tz += 0.3;
+    double squared_error = -1;
+    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
+                                         &squared_error));
+    EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
+    EXPECT_LT(squared_error, 1e-16);
+
+    testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
+    RadialIntrinsics at_truth = truth;
+    double error_at_truth = 0;
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, &at_truth,
+                                 &error_at_truth));
+    model = truth;
+    model.tz += 0.3;
+    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
+                                         &squared_error));
+    EXPECT_LT(squared_error, error_at_truth);
+    EXPECT_NEAR(model.tz, truth.tz, 0.05);
+    EXPECT_NEAR(model.focal, truth.focal, 0.01 * truth.focal);
+  }
+}
+
+}  // namespace
+}  // namespace rig_calibrator
