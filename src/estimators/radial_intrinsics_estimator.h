@@ -25,10 +25,9 @@ void RadialIntrinsicsResiduals(const std::vector<Eigen::Vector2d>& x,
                                const RadialIntrinsics& model,
                                std::vector<double>* residuals);
 
-// Minimal estimator: SolveMinimalRadialIntrinsics on kNumRadialTerms + 2
-// correspondences.
+// What both estimators share: the types, the profile and the residuals.
 template <int kNumRadialTerms>
-class RadialIntrinsicsEstimator {
+class RadialIntrinsicsEstimatorBase {
  public:
   typedef Eigen::Vector2d X_t;  // pixel relative to the principal point
   typedef Eigen::Vector3d Y_t;  // camera-frame point without tz
@@ -36,16 +35,8 @@ class RadialIntrinsicsEstimator {
 
   static_assert(kNumRadialTerms >= 0 && kNumRadialTerms <= 2,
                 "0 to 2 radial terms");
-  // f, the radial terms and tz.
-  static constexpr int kMinNumSamples = kNumRadialTerms + 2;
 
   RadialProfile profile = RadialProfile::kPolynomial;
-
-  std::vector<M_t> Estimate(const std::vector<X_t>& x,
-                            const std::vector<Y_t>& points_cam) const {
-    return SolveMinimalRadialIntrinsics(x, points_cam, profile,
-                                        kNumRadialTerms);
-  }
 
   void Residuals(const std::vector<X_t>& x, const std::vector<Y_t>& points_cam,
                  const M_t& model, std::vector<double>* residuals) const {
@@ -53,31 +44,38 @@ class RadialIntrinsicsEstimator {
   }
 };
 
-// Local (non-minimal) estimator: SolveRadialIntrinsicsLeastSquares on all
-// given correspondences (the current inliers); same residuals.
+// Minimal estimator: SolveMinimalRadialIntrinsics on kNumRadialTerms + 2
+// correspondences (f, the radial terms and tz).
 template <int kNumRadialTerms>
-class RadialIntrinsicsLocalEstimator {
+class RadialIntrinsicsEstimator
+    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms> {
  public:
-  typedef Eigen::Vector2d X_t;
-  typedef Eigen::Vector3d Y_t;
-  typedef RadialIntrinsics M_t;
+  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms>;
+  static constexpr int kMinNumSamples = kNumRadialTerms + 2;
 
-  static_assert(kNumRadialTerms >= 0 && kNumRadialTerms <= 2,
-                "0 to 2 radial terms");
-  // One more than the minimal sample: an overdetermined fit.
+  std::vector<RadialIntrinsics> Estimate(
+      const std::vector<Eigen::Vector2d>& x,
+      const std::vector<Eigen::Vector3d>& points_cam) const {
+    return SolveMinimalRadialIntrinsics(x, points_cam, Base::profile,
+                                        kNumRadialTerms);
+  }
+};
+
+// Local (non-minimal) estimator: SolveRadialIntrinsicsLeastSquares on all
+// given correspondences (the current inliers), at least one more than the
+// minimal sample.
+template <int kNumRadialTerms>
+class RadialIntrinsicsLocalEstimator
+    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms> {
+ public:
+  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms>;
   static constexpr int kMinNumSamples = kNumRadialTerms + 3;
 
-  RadialProfile profile = RadialProfile::kPolynomial;
-
-  std::vector<M_t> Estimate(const std::vector<X_t>& x,
-                            const std::vector<Y_t>& points_cam) const {
-    return SolveRadialIntrinsicsLeastSquares(x, points_cam, profile,
+  std::vector<RadialIntrinsics> Estimate(
+      const std::vector<Eigen::Vector2d>& x,
+      const std::vector<Eigen::Vector3d>& points_cam) const {
+    return SolveRadialIntrinsicsLeastSquares(x, points_cam, Base::profile,
                                              kNumRadialTerms);
-  }
-
-  void Residuals(const std::vector<X_t>& x, const std::vector<Y_t>& points_cam,
-                 const M_t& model, std::vector<double>* residuals) const {
-    RadialIntrinsicsResiduals(x, points_cam, model, residuals);
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <colmap/base/camera_models.h>
 #include <colmap/util/random.h>
+#include <glog/logging.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -157,10 +158,10 @@ constexpr double kPrincipalPointTolerancePx = 1e-6;
 constexpr double kDistortionTolerance = 1e-8;
 constexpr double kRationalDistortionTolerance = 1e-5;
 
-void ExpectParamsNear(const colmap::Camera& camera, const colmap::Camera& truth,
-                      const double focal_relative_tolerance,
-                      const double principal_point_tolerance_px,
-                      const double distortion_tolerance) {
+void ExpectFocalAndPrincipalPointNear(const colmap::Camera& camera,
+                                      const colmap::Camera& truth,
+                                      const double focal_relative_tolerance,
+                                      const double principal_point_tolerance) {
   ASSERT_EQ(camera.NumParams(), truth.NumParams());
   for (const size_t i : truth.FocalLengthIdxs()) {
     EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
@@ -168,25 +169,19 @@ void ExpectParamsNear(const colmap::Camera& camera, const colmap::Camera& truth,
   }
   for (const size_t i : truth.PrincipalPointIdxs()) {
     EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
-                principal_point_tolerance_px);
-  }
-  for (const size_t i : truth.ExtraParamsIdxs()) {
-    EXPECT_NEAR(camera.Params()[i], truth.Params()[i], distortion_tolerance)
-        << "parameter " << i;
+                principal_point_tolerance);
   }
 }
 
-void ExpectFocalAndPrincipalPointNear(const colmap::Camera& camera,
-                                      const colmap::Camera& truth,
-                                      const double focal_relative_tolerance,
-                                      const double principal_point_tolerance) {
-  for (const size_t i : truth.FocalLengthIdxs()) {
-    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
-                focal_relative_tolerance * truth.Params()[i]);
-  }
-  for (const size_t i : truth.PrincipalPointIdxs()) {
-    EXPECT_NEAR(camera.Params()[i], truth.Params()[i],
-                principal_point_tolerance);
+void ExpectParamsNear(const colmap::Camera& camera, const colmap::Camera& truth,
+                      const double focal_relative_tolerance,
+                      const double principal_point_tolerance_px,
+                      const double distortion_tolerance) {
+  ExpectFocalAndPrincipalPointNear(camera, truth, focal_relative_tolerance,
+                                   principal_point_tolerance_px);
+  for (const size_t i : truth.ExtraParamsIdxs()) {
+    EXPECT_NEAR(camera.Params()[i], truth.Params()[i], distortion_tolerance)
+        << "parameter " << i;
   }
 }
 
@@ -213,56 +208,95 @@ void ExpectInliersRecovered(const Scene& scene,
   EXPECT_LE(num_accepted_outliers, max_outlier_share * num_outliers);
 }
 
+// The scene of a model case: rays within its cone, the other options as
+// given.
+SceneOptions SceneOptionsFor(const ModelCase& model_case) {
+  SceneOptions options;
+  options.max_ray_angle_deg = model_case.max_ray_angle_deg;
+  return options;
+}
+
+// 0.5 px noise and `outlier_ratio` wrong matches.
+SceneOptions NoisySceneOptionsFor(const ModelCase& model_case,
+                                  const int num_points,
+                                  const double outlier_ratio,
+                                  const unsigned seed = 1) {
+  SceneOptions options = SceneOptionsFor(model_case);
+  options.num_points = num_points;
+  options.noise_px = 0.5;
+  options.outlier_ratio = outlier_ratio;
+  options.seed = seed;
+  return options;
+}
+
+const ModelCase& FindModelCase(const std::string& model_name) {
+  static const std::vector<ModelCase> model_cases = AllModelCases();
+  for (const ModelCase& model_case : model_cases) {
+    if (model_case.model_name == model_name) return model_case;
+  }
+  LOG(FATAL) << "no model case " << model_name;
+  return model_cases[0];
+}
+
+// One upgrade of a camera of `model_case` (640 x 480) from the scene of
+// `scene_options`, the input camera's principal point off by
+// `principal_point_error`; `success` is UpgradeCamera's return value.
+struct Upgrade {
+  colmap::Camera truth;
+  Scene scene;
+  colmap::Camera camera;
+  CameraUpgradeResult result;
+  bool success = false;
+};
+
+Upgrade RunUpgrade(
+    const ModelCase& model_case, const SceneOptions& scene_options,
+    const Eigen::Vector2d& principal_point_error,
+    const CameraUpgradeOptions& options = CameraUpgradeOptions()) {
+  Upgrade upgrade;
+  upgrade.truth =
+      MakeCamera(model_case.model_name, 640, 480, model_case.params);
+  upgrade.scene = MakeScene(upgrade.truth, scene_options);
+  upgrade.camera = MakeInputCamera(upgrade.truth, principal_point_error);
+  upgrade.success =
+      UpgradeCamera(options, upgrade.scene.points2D, upgrade.scene.points_cam,
+                    &upgrade.camera, &upgrade.result);
+  return upgrade;
+}
+
 // Exact data: tz and every parameter of every supported model.
 TEST(CameraUpgrader, ExactDataRecoversEveryModel) {
   for (const ModelCase& model_case : AllModelCases()) {
     SCOPED_TRACE(model_case.model_name);
-    const colmap::Camera truth =
-        MakeCamera(model_case.model_name, 640, 480, model_case.params);
-    SceneOptions scene_options;
-    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
-    const Scene scene = MakeScene(truth, scene_options);
-    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
-
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result))
-        << result.error_message;
-    EXPECT_EQ(result.num_inliers, scene_options.num_points);
-    EXPECT_LT(result.rms_px, 1e-8);
-    EXPECT_TRUE(result.well_conditioned);
-    EXPECT_NEAR(result.tz, scene.tz, 1e-8);
-    ExpectParamsNear(
-        camera, truth, kFocalRelativeTolerance, kPrincipalPointTolerancePx,
-        model_case.model_name == "FULL_OPENCV" ? kRationalDistortionTolerance
-                                               : kDistortionTolerance);
+    const SceneOptions scene_options = SceneOptionsFor(model_case);
+    const Upgrade upgrade =
+        RunUpgrade(model_case, scene_options, Eigen::Vector2d(4, -3));
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    EXPECT_EQ(upgrade.result.num_inliers, scene_options.num_points);
+    EXPECT_LT(upgrade.result.rms_px, 1e-8);
+    EXPECT_TRUE(upgrade.result.well_conditioned);
+    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
+    ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
+                     kPrincipalPointTolerancePx,
+                     model_case.model_name == "FULL_OPENCV"
+                         ? kRationalDistortionTolerance
+                         : kDistortionTolerance);
   }
 }
 
 // A principal point guess at the image center, 19 px from the truth.
 TEST(CameraUpgrader, ExactDataFromImageCenter) {
-  for (const ModelCase& model_case : AllModelCases()) {
-    if (model_case.model_name != "OPENCV" &&
-        model_case.model_name != "OPENCV_FISHEYE") {
-      continue;
-    }
-    SCOPED_TRACE(model_case.model_name);
-    const colmap::Camera truth =
-        MakeCamera(model_case.model_name, 640, 480, model_case.params);
-    SceneOptions scene_options;
-    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
-    const Scene scene = MakeScene(truth, scene_options);
-    colmap::Camera camera =
-        MakeInputCamera(truth, Eigen::Vector2d(320 - truth.PrincipalPointX(),
-                                               240 - truth.PrincipalPointY()));
-
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result))
-        << result.error_message;
-    EXPECT_EQ(result.num_inliers, scene_options.num_points);
-    EXPECT_NEAR(result.tz, scene.tz, 1e-8);
-    ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+  for (const std::string model_name : {"OPENCV", "OPENCV_FISHEYE"}) {
+    SCOPED_TRACE(model_name);
+    const ModelCase& model_case = FindModelCase(model_name);
+    const SceneOptions scene_options = SceneOptionsFor(model_case);
+    // The truth's principal point is at (335, 228).
+    const Upgrade upgrade = RunUpgrade(model_case, scene_options,
+                                       Eigen::Vector2d(320 - 335, 240 - 228));
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    EXPECT_EQ(upgrade.result.num_inliers, scene_options.num_points);
+    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
+    ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
                      kPrincipalPointTolerancePx, kDistortionTolerance);
   }
 }
@@ -273,30 +307,22 @@ TEST(CameraUpgrader, ExactDataFromImageCenter) {
 TEST(CameraUpgrader, NoisyDataWithOutliers) {
   for (const ModelCase& model_case : AllModelCases()) {
     SCOPED_TRACE(model_case.model_name);
-    const colmap::Camera truth =
-        MakeCamera(model_case.model_name, 640, 480, model_case.params);
-    SceneOptions scene_options;
-    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
-    scene_options.num_points = 1000;
-    scene_options.noise_px = 0.5;
-    scene_options.outlier_ratio = 0.3;
-    const Scene scene = MakeScene(truth, scene_options);
-    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
-
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result))
-        << result.error_message;
-    ExpectInliersRecovered(scene, result, 0.99, 0.005);
+    const Upgrade upgrade =
+        RunUpgrade(model_case, NoisySceneOptionsFor(model_case, 1000, 0.3),
+                   Eigen::Vector2d(4, -3));
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    const CameraUpgradeResult& result = upgrade.result;
+    ExpectInliersRecovered(upgrade.scene, result, 0.99, 0.005);
     // 0.5 px per coordinate: 0.71 px in 2D.
     EXPECT_GT(result.rms_px, 0.6);
     EXPECT_LT(result.rms_px, 0.8);
-    EXPECT_NEAR(result.tz, scene.tz, 0.005);
-    ExpectFocalAndPrincipalPointNear(camera, truth, 0.002, 1.0);
+    EXPECT_NEAR(result.tz, upgrade.scene.tz, 0.005);
+    ExpectFocalAndPrincipalPointNear(upgrade.camera, upgrade.truth, 0.002, 1.0);
     EXPECT_TRUE(result.well_conditioned);
     EXPECT_LT(std::abs(result.tz_focal_correlation), 0.95);
     EXPECT_GT(result.focal_stddev_at_1px, 0);
-    EXPECT_LT(result.focal_stddev_at_1px, 0.01 * camera.MeanFocalLength());
+    EXPECT_LT(result.focal_stddev_at_1px,
+              0.01 * upgrade.camera.MeanFocalLength());
   }
 }
 
@@ -306,133 +332,96 @@ TEST(CameraUpgrader, NoisyDataWithOutliers) {
 TEST(CameraUpgrader, SingleImage) {
   for (const ModelCase& model_case : AllModelCases()) {
     SCOPED_TRACE(model_case.model_name);
-    const colmap::Camera truth =
-        MakeCamera(model_case.model_name, 640, 480, model_case.params);
-    SceneOptions scene_options;
-    scene_options.max_ray_angle_deg = model_case.max_ray_angle_deg;
-    scene_options.num_points = 150;
-    scene_options.noise_px = 0.5;
-    scene_options.outlier_ratio = 0.2;
-    scene_options.seed = 2;
-    const Scene scene = MakeScene(truth, scene_options);
-    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
-
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result))
-        << result.error_message;
-    ExpectInliersRecovered(scene, result, 0.97, 0.02);
-    EXPECT_NEAR(result.tz, scene.tz, 0.02);
-    ExpectFocalAndPrincipalPointNear(camera, truth, 0.005, 1.0);
+    const Upgrade upgrade =
+        RunUpgrade(model_case, NoisySceneOptionsFor(model_case, 150, 0.2, 2),
+                   Eigen::Vector2d(4, -3));
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    ExpectInliersRecovered(upgrade.scene, upgrade.result, 0.97, 0.02);
+    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 0.02);
+    ExpectFocalAndPrincipalPointNear(upgrade.camera, upgrade.truth, 0.005, 1.0);
   }
 }
 
 // Points all at 9.9-10.1 m in a 5 degree cone: only f / (c + tz) is
 // observed. Measured: correlation >= 0.995, focal stddev at 1 px >= 110 px.
 TEST(CameraUpgrader, EqualDepthsNarrowViewIsPoorlyConditioned) {
-  for (const ModelCase& model_case : AllModelCases()) {
-    if (model_case.model_name != "SIMPLE_PINHOLE" &&
-        model_case.model_name != "OPENCV" &&
-        model_case.model_name != "OPENCV_FISHEYE") {
-      continue;
-    }
-    SCOPED_TRACE(model_case.model_name);
-    const colmap::Camera truth =
-        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+  for (const std::string model_name :
+       {"SIMPLE_PINHOLE", "OPENCV", "OPENCV_FISHEYE"}) {
+    SCOPED_TRACE(model_name);
     SceneOptions scene_options;
     scene_options.max_ray_angle_deg = 5;
     scene_options.min_distance = 9.9;
     scene_options.max_distance = 10.1;
     scene_options.noise_px = 0.5;
-    const Scene scene = MakeScene(truth, scene_options);
-    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(1, -1));
-
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result))
-        << result.error_message;
-    EXPECT_FALSE(result.well_conditioned);
-    EXPECT_GT(std::abs(result.tz_focal_correlation), 0.99);
-    EXPECT_GT(result.focal_stddev_at_1px, 0.1 * camera.MeanFocalLength());
+    const Upgrade upgrade = RunUpgrade(FindModelCase(model_name), scene_options,
+                                       Eigen::Vector2d(1, -1));
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    EXPECT_FALSE(upgrade.result.well_conditioned);
+    EXPECT_GT(std::abs(upgrade.result.tz_focal_correlation), 0.99);
+    EXPECT_GT(upgrade.result.focal_stddev_at_1px,
+              0.1 * upgrade.camera.MeanFocalLength());
   }
 }
 
 // A camera pooled over many frames: RANSAC on a subset, inliers on all.
 TEST(CameraUpgrader, RansacOnSubsetOfManyPoints) {
-  const colmap::Camera truth =
-      MakeCamera("OPENCV_FISHEYE", 640, 480,
-                 {300, 302, 335, 228, 0.02, -0.005, 0.002, -0.0005});
-  SceneOptions scene_options;
-  scene_options.max_ray_angle_deg = 75;
-  scene_options.num_points = 20000;
-  scene_options.noise_px = 0.5;
-  scene_options.outlier_ratio = 0.3;
-  const Scene scene = MakeScene(truth, scene_options);
-  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+  const ModelCase& model_case = FindModelCase("OPENCV_FISHEYE");
   CameraUpgradeOptions options;
   options.max_num_ransac_points = 1000;
-  CameraUpgradeResult result;
-  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
-                            &result))
-      << result.error_message;
-  ExpectInliersRecovered(scene, result, 0.99, 0.001);
-  EXPECT_NEAR(result.tz, scene.tz, 0.002);
-  ExpectFocalAndPrincipalPointNear(camera, truth, 0.0005, 0.1);
+  const Upgrade upgrade =
+      RunUpgrade(model_case, NoisySceneOptionsFor(model_case, 20000, 0.3),
+                 Eigen::Vector2d(4, -3), options);
+  ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+  ExpectInliersRecovered(upgrade.scene, upgrade.result, 0.99, 0.001);
+  EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 0.002);
+  ExpectFocalAndPrincipalPointNear(upgrade.camera, upgrade.truth, 0.0005, 0.1);
 }
 
 TEST(CameraUpgrader, FixedPrincipalPoint) {
-  const colmap::Camera truth =
-      MakeCamera("RADIAL", 640, 480, {500, 335, 228, -0.3, 0.08});
-  const Scene scene = MakeScene(truth, SceneOptions());
-  colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d::Zero());
+  const ModelCase& model_case = FindModelCase("RADIAL");
   CameraUpgradeOptions options;
   options.refine_principal_point = false;
-  CameraUpgradeResult result;
-  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
-                            &result))
-      << result.error_message;
-  EXPECT_EQ(camera.PrincipalPointX(), truth.PrincipalPointX());
-  EXPECT_EQ(camera.PrincipalPointY(), truth.PrincipalPointY());
-  EXPECT_NEAR(result.tz, scene.tz, 1e-8);
-  ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+  const Upgrade upgrade = RunUpgrade(model_case, SceneOptionsFor(model_case),
+                                     Eigen::Vector2d::Zero(), options);
+  ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+  EXPECT_EQ(upgrade.camera.PrincipalPointX(), upgrade.truth.PrincipalPointX());
+  EXPECT_EQ(upgrade.camera.PrincipalPointY(), upgrade.truth.PrincipalPointY());
+  EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
+  ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
                    kPrincipalPointTolerancePx, kDistortionTolerance);
 
   // With a wrong fixed principal point the other parameters compensate
   // only partly.
-  colmap::Camera shifted = MakeInputCamera(truth, Eigen::Vector2d(3, 0));
-  ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam, &shifted,
-                            &result));
-  EXPECT_EQ(shifted.PrincipalPointX(), truth.PrincipalPointX() + 3);
-  EXPECT_GT(result.rms_px, 0.1);
+  const Upgrade shifted = RunUpgrade(model_case, SceneOptionsFor(model_case),
+                                     Eigen::Vector2d(3, 0), options);
+  ASSERT_TRUE(shifted.success);
+  EXPECT_EQ(shifted.camera.PrincipalPointX(),
+            shifted.truth.PrincipalPointX() + 3);
+  EXPECT_GT(shifted.result.rms_px, 0.1);
 }
 
-// The result depends only on the input, not on COLMAP's random state.
+// The result depends only on the input, not on COLMAP's random state: equal
+// to the last bit after different seeds of COLMAP's generator.
 TEST(CameraUpgrader, Deterministic) {
-  const colmap::Camera truth = MakeCamera(
-      "OPENCV", 640, 480, {500, 502, 335, 228, -0.3, 0.08, 0.001, -0.0015});
-  SceneOptions scene_options;
-  scene_options.noise_px = 0.5;
-  scene_options.outlier_ratio = 0.3;
-  const Scene scene = MakeScene(truth, scene_options);
-  std::vector<std::vector<double>> params;
-  std::vector<double> tzs;
+  const ModelCase& model_case = FindModelCase("OPENCV");
+  const SceneOptions scene_options = NoisySceneOptionsFor(model_case, 400, 0.3);
+  std::vector<Upgrade> upgrades;
   for (const unsigned seed : {1u, 2u}) {
     colmap::SetPRNGSeed(seed);
-    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
-    CameraUpgradeResult result;
-    ASSERT_TRUE(UpgradeCamera(CameraUpgradeOptions(), scene.points2D,
-                              scene.points_cam, &camera, &result));
-    params.push_back(camera.Params());
-    tzs.push_back(result.tz);
+    upgrades.push_back(
+        RunUpgrade(model_case, scene_options, Eigen::Vector2d(4, -3)));
+    ASSERT_TRUE(upgrades.back().success);
   }
-  EXPECT_EQ(params[0], params[1]);
-  EXPECT_EQ(tzs[0], tzs[1]);
+  EXPECT_EQ(upgrades[0].camera.Params(), upgrades[1].camera.Params());
+  EXPECT_EQ(upgrades[0].result.tz, upgrades[1].result.tz);
+  EXPECT_EQ(upgrades[0].result.inlier_mask, upgrades[1].result.inlier_mask);
 }
 
 TEST(CameraUpgrader, NonFiniteCorrespondencesAreOutliers) {
+  const ModelCase& model_case = FindModelCase("SIMPLE_RADIAL");
   const colmap::Camera truth =
-      MakeCamera("SIMPLE_RADIAL", 640, 480, {500, 335, 228, -0.15});
-  Scene scene = MakeScene(truth, SceneOptions());
+      MakeCamera(model_case.model_name, 640, 480, model_case.params);
+  Scene scene = MakeScene(truth, SceneOptionsFor(model_case));
   scene.points2D[3].x() = std::numeric_limits<double>::quiet_NaN();
   scene.points_cam[7].z() = std::numeric_limits<double>::infinity();
   colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
@@ -447,9 +436,10 @@ TEST(CameraUpgrader, NonFiniteCorrespondencesAreOutliers) {
 }
 
 TEST(CameraUpgrader, RejectsUnsupportedModelAndBadInput) {
+  const ModelCase& model_case = FindModelCase("RADIAL");
   const colmap::Camera truth =
-      MakeCamera("RADIAL", 640, 480, {500, 335, 228, -0.3, 0.08});
-  const Scene scene = MakeScene(truth, SceneOptions());
+      MakeCamera(model_case.model_name, 640, 480, model_case.params);
+  const Scene scene = MakeScene(truth, SceneOptionsFor(model_case));
   CameraUpgradeResult result;
 
   colmap::Camera fov = MakeCamera("FOV", 640, 480, {500, 500, 320, 240, 0.1});

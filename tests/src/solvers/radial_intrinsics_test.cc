@@ -14,32 +14,33 @@ using testing::MakeRadialIntrinsics;
 
 // The projection agrees with COLMAP's models whose radial part it is.
 TEST(RadialIntrinsics, ProjectMatchesColmapModels) {
-  const RadialIntrinsics polynomial =
-      MakeRadialIntrinsics(RadialProfile::kPolynomial, 2, 0.7, 500, -0.3, 0.08);
-  const RadialIntrinsics equidistant = MakeRadialIntrinsics(
-      RadialProfile::kEquidistant, 2, 0.7, 300, 0.03, -0.005);
-  const std::vector<double> radial_params = {500, 0, 0, -0.3, 0.08};
-  const std::vector<double> fisheye_params = {300, 0, 0, 0.03, -0.005};
-  for (const Eigen::Vector3d& point_cam :
-       {Eigen::Vector3d(1, -2, 4), Eigen::Vector3d(-3, 0.5, 1.2),
-        Eigen::Vector3d(1e-12, 0, 3)}) {
-    const double depth = point_cam.z() + 0.7;
-    Eigen::Vector2d x, expected;
-    ASSERT_TRUE(polynomial.Project(point_cam, &x));
-    colmap::CameraModelWorldToImage(colmap::RadialCameraModel::kModelId,
-                                    radial_params, point_cam.x() / depth,
-                                    point_cam.y() / depth, &expected.x(),
-                                    &expected.y());
-    EXPECT_LT((x - expected).norm(), 1e-9);
-    ASSERT_TRUE(equidistant.Project(point_cam, &x));
-    colmap::CameraModelWorldToImage(colmap::RadialFisheyeCameraModel::kModelId,
-                                    fisheye_params, point_cam.x() / depth,
-                                    point_cam.y() / depth, &expected.x(),
-                                    &expected.y());
-    EXPECT_LT((x - expected).norm(), 1e-9);
+  struct Case {
+    RadialIntrinsics model;
+    int colmap_model_id;
+    std::vector<double> colmap_params;
+  };
+  for (const Case& c : {Case{MakeRadialIntrinsics(RadialProfile::kPolynomial, 2,
+                                                  0.7, 500, -0.3, 0.08),
+                             colmap::RadialCameraModel::kModelId,
+                             {500, 0, 0, -0.3, 0.08}},
+                        Case{MakeRadialIntrinsics(RadialProfile::kEquidistant,
+                                                  2, 0.7, 300, 0.03, -0.005),
+                             colmap::RadialFisheyeCameraModel::kModelId,
+                             {300, 0, 0, 0.03, -0.005}}}) {
+    for (const Eigen::Vector3d& point_cam :
+         {Eigen::Vector3d(1, -2, 4), Eigen::Vector3d(-3, 0.5, 1.2),
+          Eigen::Vector3d(1e-12, 0, 3)}) {
+      const double depth = point_cam.z() + 0.7;
+      Eigen::Vector2d x, expected;
+      ASSERT_TRUE(c.model.Project(point_cam, &x));
+      colmap::CameraModelWorldToImage(
+          c.colmap_model_id, c.colmap_params, point_cam.x() / depth,
+          point_cam.y() / depth, &expected.x(), &expected.y());
+      EXPECT_LT((x - expected).norm(), 1e-9);
+    }
+    Eigen::Vector2d x;
+    EXPECT_FALSE(c.model.Project(Eigen::Vector3d(1, 1, -0.7), &x));
   }
-  Eigen::Vector2d x;
-  EXPECT_FALSE(polynomial.Project(Eigen::Vector3d(1, 1, -0.7), &x));
 }
 
 TEST(RadialIntrinsics, SignedRadialCoordinateAndProfileAngle) {
