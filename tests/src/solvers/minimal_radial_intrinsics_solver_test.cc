@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "src/solvers/radial_profile_fit.h"
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
@@ -147,6 +149,90 @@ TEST(SolveMinimalRadialIntrinsics, EquidistantEveryExactInstance) {
                        Case{RadialProfile::kEquidistant, 2, 11}}) {
     ExpectEveryInstanceSolved(c);
   }
+}
+
+// The solutions found independently of the solver: every sign change of
+// det M(tz), with M's rows [phi_i, phi_i^3, .., -rho_i] computed directly,
+// on a scan 16 times finer than the solver's (the depth of the nearest point
+// from 1e-4 to 1e4 times the largest |s|, log-spaced), refined by bisection;
+// kept if the linear fit at that tz has f > 0 and a growing profile.
+std::vector<double> BruteForceSolutionTzs(const Instance& instance,
+                                          const RadialProfile profile,
+                                          const int num_terms) {
+  const RadialIntrinsicsScene& scene = instance.scene;
+  const int size = num_terms + 2;
+  double min_c = std::numeric_limits<double>::infinity(), max_s = 0;
+  for (const Eigen::Vector3d& point : scene.points_cam) {
+    min_c = std::min(min_c, point.z());
+    max_s = std::max(max_s, point.head<2>().norm());
+  }
+  const auto det = [&](const double tz) {
+    Eigen::MatrixXd M(size, size);
+    for (int i = 0; i < size; ++i) {
+      const double phi = ProfileAngle(
+          profile, SignedRadialCoordinate(scene.x[i], scene.points_cam[i]),
+          scene.points_cam[i].z() + tz);
+      for (int j = 0; j <= num_terms; ++j) M(i, j) = std::pow(phi, 2 * j + 1);
+      M(i, size - 1) = -scene.x[i].norm();
+    }
+    return M.determinant();
+  };
+  const auto tz_of = [&](const double u) {
+    return -min_c + max_s * std::exp(u);
+  };
+  constexpr int kNumSteps = 4096;
+  std::vector<double> tzs;
+  for (int k = 0; k < kNumSteps; ++k) {
+    double lo = 9.2 * (2.0 * k / kNumSteps - 1);
+    double hi = 9.2 * (2.0 * (k + 1) / kNumSteps - 1);
+    const bool lo_negative = det(tz_of(lo)) < 0;
+    if (lo_negative == (det(tz_of(hi)) < 0)) continue;
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      const double middle = (lo + hi) / 2;
+      ((det(tz_of(middle)) < 0) == lo_negative ? lo : hi) = middle;
+    }
+    RadialIntrinsics model;
+    model.profile = profile;
+    model.num_radial_terms = num_terms;
+    model.tz = tz_of((lo + hi) / 2);
+    double squared_error = 0;
+    if (FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error) &&
+        RadiusGrowsOverPoints(scene.x, scene.points_cam, model)) {
+      tzs.push_back(model.tz);
+    }
+  }
+  return tzs;
+}
+
+// Every solution that the brute-force scan finds is returned (a solver that
+// finds the truth but drops other solutions fails), on 100 instances per
+// case.
+TEST(SolveMinimalRadialIntrinsics, FindsEverySolution) {
+  int num_solutions = 0;
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    for (int num_terms = 0; num_terms <= 2; ++num_terms) {
+      for (int seed = 0; seed < 100; ++seed) {
+        const Instance instance = MakeInstance(profile, num_terms, seed);
+        const std::vector<RadialIntrinsics> solutions =
+            SolveMinimalRadialIntrinsics(instance.scene.x,
+                                         instance.scene.points_cam, profile,
+                                         num_terms);
+        for (const double tz :
+             BruteForceSolutionTzs(instance, profile, num_terms)) {
+          ++num_solutions;
+          double closest = std::numeric_limits<double>::infinity();
+          for (const RadialIntrinsics& solution : solutions) {
+            closest = std::min(closest, std::abs(solution.tz - tz));
+          }
+          EXPECT_LT(closest, 1e-6 * instance.mean_depth)
+              << CaseName({profile, num_terms, 0}) << " seed " << seed << " tz "
+              << tz;
+        }
+      }
+    }
+  }
+  std::cout << num_solutions << " solutions found by the scan\n";
 }
 
 // Points on the wrong half-line of the radial pose (s < 0) fit only
