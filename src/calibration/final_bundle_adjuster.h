@@ -6,11 +6,12 @@
 //
 // theta_i the COLMAP camera model parameters of camera i, P_i its
 // cam_from_rig, Q_j the rig_from_world of frameset j, X_p a map point, rho the
-// Cauchy loss. Map points are held fixed unless asked (they fix the world
-// frame and scale); the reference camera's cam_from_rig stays the identity
-// (it defines the rig frame). After a first solve, outliers are pruned
-// relative to each camera's robust residual spread and the problem is solved
-// again.
+// Cauchy loss (the cost of one observation:
+// src/geometry/rig_reprojection_cost.h). Map points are held fixed unless asked
+// (they fix the world frame and scale); the reference camera's cam_from_rig
+// stays the identity (it defines the rig frame). After a first solve, outliers
+// are pruned relative to each camera's robust residual spread and the problem
+// is solved again.
 //
 // Speed: each frameset's rig pose is seen only through the few shared
 // camera blocks, so the rig poses are the eliminated group of the Schur
@@ -22,10 +23,6 @@
 #include <string>
 
 #include "src/calibration/rig_dataset.h"
-
-namespace ceres {
-class CostFunction;
-}  // namespace ceres
 
 namespace rig_calibrator {
 
@@ -42,9 +39,11 @@ struct FinalBundleAdjustmentOptions {
   // Map points (by point3D_id). Only points with an id that are observed at
   // least twice are refined: a point seen once has 3 unknowns for 2
   // residuals, and points with id -1 are a separate point per observation.
-  // When no fixed point remains to anchor the world frame, the result is
-  // moved back onto the map by the similarity that best aligns the refined
-  // points with their map positions (the reprojection errors do not change).
+  // The points that stay fixed anchor the world frame and scale, and the
+  // solution is left where they hold it. Only when every observed point is
+  // refined (nothing fixes the gauge) is the result moved back onto the map
+  // by the similarity that best aligns the refined points with their map
+  // positions, which changes no reprojection error (map_anchoring.h).
   bool refine_points = false;
   // Outlier pruning after a first solve, then solve again. An observation is
   // an outlier if
@@ -87,25 +86,13 @@ struct FinalBundleAdjustmentSummary {
 // rig pose and whose camera is calibrated. Updates calibration->cameras,
 // cam_from_rig, rig_from_world, images[i].inlier_mask / num_inliers / rms_px /
 // used (images outside the adjustment get an all-zero mask and used = false)
-// and, with refine_points, refined_points3D. On bad input (inconsistent
-// sizes, unknown camera model, no usable observation) or a Ceres failure it
+// and, with refine_points, refined_points3D. On bad input (a dataset that
+// ValidateDataset rejects, inconsistent sizes, unknown camera model, no
+// usable observation) or a Ceres failure it
 // logs the reason, leaves `calibration` unchanged and returns false.
 // `summary` may be null.
 bool AdjustRig(const FinalBundleAdjustmentOptions& options,
                const RigDataset& dataset, RigCalibration* calibration,
                FinalBundleAdjustmentSummary* summary);
-
-// The cost of one observation, for Ceres: residual pi_theta(P Q X) - x in
-// pixels (2). Parameter blocks: rig_from_world Q and cam_from_rig P as
-// [qw, qx, qy, qz, tx, ty, tz] (for ceres::QuaternionManifold times R^3), the
-// camera's COLMAP parameters theta and, when `point3D` is null, the point X
-// (3); a given `point3D` is held fixed. Jacobians are analytic for the poses
-// and the point, forward-mode (ceres::Jet) through the templated COLMAP
-// camera model. Evaluation fails (returns false) for a point that is not in
-// front of the camera. Null for an unknown camera model id. The caller owns
-// the result.
-ceres::CostFunction* CreateRigReprojectionError(int model_id,
-                                                const Eigen::Vector2d& observed,
-                                                const Eigen::Vector3d* point3D);
 
 }  // namespace rig_calibrator

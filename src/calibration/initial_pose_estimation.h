@@ -5,8 +5,8 @@
 //  - kRadial (1dr): the 1D radial pose (R, tx, ty; tz unknown) by LO-RANSAC on
 //    the 5-point solver. Needs only the principal point, taken as the camera's
 //    initial one (the image center unless given).
-//  - kKnownIntrinsics (known, known_refine): the full pose with the given
-//    intrinsics, by COLMAP's P3P LO-RANSAC (EstimateAbsolutePose).
+//  - kKnownIntrinsics (known, known_refine, known_ra): the full pose with the
+//    given intrinsics, by COLMAP's P3P LO-RANSAC (EstimateAbsolutePose).
 //  - kPoseAndIntrinsics (rd, rd_ra): the full pose plus focal length and
 //    distortion from this image alone: the radial pose, then the camera
 //    upgrade (tz and intrinsics) on this image's correspondences only, as in

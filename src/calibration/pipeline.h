@@ -1,5 +1,5 @@
 // The calibration pipeline (paper §3) and the paper's baselines (§5.1) as
-// methods of one entry point:
+// methods of one entry point (calibration_method.h):
 //
 //   1dr           Inf+1DR+RA (default): 1D radial pose per image, robust radial
 //                 rig initialization, radial BA with principal points, camera
@@ -8,9 +8,12 @@
 //                 initialization on full poses, final BA.
 //   rd            Inf+RD: as rd_ra, but the rig is taken from the best complete
 //                 frameset (Heng et al.'s initialization).
-//   known         Inf+K: intrinsics given, full pose per image, robust rig
-//                 initialization, final BA of extrinsics and rig poses.
+//   known         Inf+K: intrinsics given, full pose per image, the rig from
+//                 the best complete frameset (Heng et al.), final BA of
+//                 extrinsics and rig poses.
 //   known_refine  Inf+K+RI: as known, intrinsics refined in the final BA.
+//   known_ra      not in the paper: as known, with the robust rig
+//                 initialization of rd_ra.
 //
 // Problems the pipeline can work around are reported as diagnostics instead
 // of failures: e.g. a rig whose cameras all have parallel principal axes
@@ -21,31 +24,16 @@
 #include <string>
 #include <vector>
 
+#include "src/calibration/calibration_method.h"
 #include "src/calibration/camera_upgrader.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
+#include "src/calibration/pipeline_report.h"
 #include "src/calibration/radial_bundle_adjuster.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/calibration/rig_initializer.h"
 
 namespace rig_calibrator {
-
-enum class CalibrationMethod { kKnown, kKnownRefine, kRd, kRdRa, kRadial1D };
-
-// "known", "known_refine", "rd", "rd_ra", "1dr".
-bool CalibrationMethodFromName(const std::string& name,
-                               CalibrationMethod* method);
-std::string CalibrationMethodName(CalibrationMethod method);
-
-struct Diagnostic {
-  enum class Level { kInfo, kWarning, kError };
-  Level level = Level::kInfo;
-  std::string code;  // stable identifier, e.g. "parallel_principal_axes"
-  std::string message;
-  std::vector<int> cameras;    // camera indices concerned
-  std::vector<int> framesets;  // frameset indices concerned
-};
-std::string DiagnosticLevelName(Diagnostic::Level level);
 
 struct PipelineOptions {
   CalibrationMethod method = CalibrationMethod::kRadial1D;
@@ -67,37 +55,6 @@ struct PipelineOptions {
   int num_threads = -1;
   unsigned int seed = 0;
   bool print_progress = true;
-};
-
-struct StageTiming {
-  std::string stage;
-  double seconds = 0;  // wall time
-  // CPU time of the whole process (all threads, user + system) during the
-  // stage: unlike wall time, hardly affected by other work on the machine.
-  double cpu_seconds = 0;
-};
-
-struct PipelineReport {
-  CalibrationMethod requested_method = CalibrationMethod::kRadial1D;
-  CalibrationMethod used_method = CalibrationMethod::kRadial1D;
-  std::vector<Diagnostic> diagnostics;
-  std::vector<StageTiming> timings;
-  int num_images = 0;
-  int num_localized = 0;  // on their own, in the first stage
-  int num_used = 0;       // in the final calibration
-  int num_framesets_posed = 0;
-  double final_rms_px = 0;
-  double total_seconds = 0;
-  // The rig as it entered the final bundle adjustment (paper Fig. 6, the
-  // "initial estimates"): from the rig initialization (rd, rd_ra, known*) or
-  // the camera upgrade (1dr). Empty when the pipeline stopped before.
-  std::vector<colmap::Camera> initial_cameras;
-  std::vector<Rigid3d> initial_cam_from_rig;
-  std::vector<bool> initial_camera_calibrated;
-  // Why the pipeline stopped, when CalibrateRig returns false.
-  std::string error;
-
-  bool HasErrors() const;
 };
 
 // Calibrates every camera of `dataset` (intrinsics and cam_from_rig) and the

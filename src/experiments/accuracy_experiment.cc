@@ -9,6 +9,8 @@
 #include <limits>
 #include <sstream>
 
+#include "src/experiments/experiment_calibration.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -26,25 +28,15 @@ AccuracyRun CalibrateRecording(const Recording& recording,
   run.preset = recording.preset;
   run.scene = recording.scene;
   run.method = method;
-  run.used_method = method;
   run.camera_names = recording.rig.truth.camera_names;
-  SyntheticRig rig = recording.rig;
-  if (method == CalibrationMethod::kKnown ||
-      method == CalibrationMethod::kKnownRefine) {
-    SetKnownIntrinsics(&rig);
-  }
-  PipelineOptions pipeline;
-  pipeline.method = method;
-  pipeline.print_progress = false;
-  pipeline.num_threads = 1;
-  pipeline.seed = seed;
-  RigCalibration calibration;
-  PipelineReport report;
-  run.success = CalibrateRig(pipeline, rig.dataset, &calibration, &report);
-  run.seconds = report.total_seconds;
-  run.used_method = report.used_method;
+  const SyntheticRig& rig = recording.rig;
+  const ExperimentCalibration result = CalibrateSyntheticRig(rig, method, seed);
+  const RigCalibration& calibration = result.calibration;
+  run.success = result.success;
+  run.seconds = result.report.total_seconds;
+  run.used_method = result.report.used_method;
   if (!run.success) {
-    run.error = report.error;
+    run.error = result.report.error;
     return run;
   }
   run.camera_calibrated = calibration.camera_calibrated;
@@ -78,43 +70,36 @@ AccuracyRun CalibrateRecording(const Recording& recording,
 using Measure = std::function<double(const AccuracyRun&, size_t camera)>;
 
 struct MeasureColumn {
-  std::string name;  // with unit
+  std::string name;      // with unit, for the tables
+  std::string csv_name;  // with unit, for the CSV columns
   Measure value;
   int precision;
 };
 
+// A field of the camera's CameraError, times `factor` (unit change).
+Measure CameraErrorField(double CameraError::*field, double factor) {
+  return [field, factor](const AccuracyRun& run, size_t c) {
+    return factor * (run.errors.cameras[c].*field);
+  };
+}
+
 const std::vector<MeasureColumn>& Measures() {
   static const std::vector<MeasureColumn> measures = {
-      {"rotation (deg)",
-       [](const AccuracyRun& run, size_t c) {
-         return run.errors.cameras[c].rotation_deg;
-       },
-       3},
-      {"translation (cm)",
-       [](const AccuracyRun& run, size_t c) {
-         return 100 * run.errors.cameras[c].center_error;
-       },
-       3},
-      {"reprojection (px)",
+      {"rotation (deg)", "rotation_deg",
+       CameraErrorField(&CameraError::rotation_deg, 1), 3},
+      {"translation (cm)", "translation_cm",
+       CameraErrorField(&CameraError::center_error, 100), 3},
+      {"reprojection (px)", "reprojection_px",
        [](const AccuracyRun& run, size_t c) {
          return run.reprojection_rms_px[c];
        },
        3},
-      {"focal (%)",
-       [](const AccuracyRun& run, size_t c) {
-         return run.errors.cameras[c].focal_error_percent;
-       },
-       3},
-      {"principal point (px)",
-       [](const AccuracyRun& run, size_t c) {
-         return run.errors.cameras[c].principal_point_error_px;
-       },
-       2},
-      {"projection diff. (px)",
-       [](const AccuracyRun& run, size_t c) {
-         return run.errors.cameras[c].mean_projection_diff_px;
-       },
-       3},
+      {"focal (%)", "focal_percent",
+       CameraErrorField(&CameraError::focal_error_percent, 1), 3},
+      {"principal point (px)", "principal_point_px",
+       CameraErrorField(&CameraError::principal_point_error_px, 1), 2},
+      {"projection diff. (px)", "projection_diff_px",
+       CameraErrorField(&CameraError::mean_projection_diff_px, 1), 3},
   };
   return measures;
 }
@@ -269,12 +254,11 @@ std::string FormatAccuracyTable(const std::vector<AccuracyRun>& runs) {
 
 std::string AccuracySummaryCsv(const std::vector<AccuracyRun>& runs) {
   std::ostringstream csv;
-  csv << "rig,scene,method,used_method,success,cameras_calibrated,cameras,"
-         "rotation_deg_mean,rotation_deg_max,translation_cm_mean,"
-         "translation_cm_max,reprojection_px_mean,reprojection_px_max,"
-         "focal_percent_mean,focal_percent_max,principal_point_px_mean,"
-         "principal_point_px_max,projection_diff_px_mean,"
-         "projection_diff_px_max,seconds\n";
+  csv << "rig,scene,method,used_method,success,cameras_calibrated,cameras";
+  for (const MeasureColumn& measure : Measures()) {
+    csv << "," << measure.csv_name << "_mean," << measure.csv_name << "_max";
+  }
+  csv << ",seconds\n";
   csv << std::setprecision(6);
   for (const AccuracyRun& run : runs) {
     csv << RigPresetName(run.preset) << "," << run.scene << ","

@@ -2,15 +2,17 @@
 // method calibrates the whole recording of every rig preset in every scene,
 // and each camera's calibration is compared with the truth: rotation and
 // camera-center error of cam_from_rig, reprojection error, focal length
-// error and the projection difference of the intrinsics (src/evaluation/evaluation.h).
+// error and the projection difference of the intrinsics
+// (src/evaluation/evaluation.h).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "src/experiments/benchmark_scenarios.h"
-#include "src/evaluation/evaluation.h"
 #include "src/calibration/pipeline.h"
+#include "src/evaluation/evaluation.h"
+#include "src/experiments/benchmark_scenarios.h"
+#include "src/experiments/paper_methods.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
@@ -18,10 +20,7 @@ namespace rig_calibrator {
 struct AccuracyOptions {
   std::vector<RigPreset> presets = AllRigPresets();
   std::vector<BenchmarkScene> scenes = BenchmarkScenes();
-  std::vector<CalibrationMethod> methods = {
-      CalibrationMethod::kKnown, CalibrationMethod::kKnownRefine,
-      CalibrationMethod::kRd, CalibrationMethod::kRdRa,
-      CalibrationMethod::kRadial1D};
+  std::vector<CalibrationMethod> methods = AccuracyTableMethods();
   int num_framesets = 60;
   // The recording of each preset and scene (preset, depths and
   // num_framesets are set per run; the rest, e.g. noise and wrong matches,

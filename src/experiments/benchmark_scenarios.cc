@@ -3,19 +3,8 @@
 namespace rig_calibrator {
 
 std::vector<BenchmarkScene> BenchmarkScenes() {
-  BenchmarkScene indoor;
-  indoor.name = "indoor";
-  indoor.min_depth = 1.0;
-  indoor.max_depth = 8.0;
-  indoor.near_planar_ratio = 0.2;
-  indoor.good_center_error = 0.01;
-  BenchmarkScene outdoor;
-  outdoor.name = "outdoor";
-  outdoor.min_depth = 4.0;
-  outdoor.max_depth = 60.0;
-  outdoor.near_planar_ratio = 0.3;
-  outdoor.good_center_error = 0.02;
-  return {indoor, outdoor};
+  // name, depths (m), share on the ground plane, good center error (m).
+  return {{"indoor", 1.0, 8.0, 0.2, 0.01}, {"outdoor", 4.0, 60.0, 0.3, 0.02}};
 }
 
 bool BenchmarkSceneFromName(const std::string& name, BenchmarkScene* scene) {

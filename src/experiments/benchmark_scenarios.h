@@ -25,6 +25,7 @@ struct BenchmarkScene {
 // "indoor": a room, points 1-8 m away, 20 % on the floor, good < 1 cm.
 // "outdoor": a street, points 4-60 m away, 30 % on the road, good < 2 cm.
 std::vector<BenchmarkScene> BenchmarkScenes();
+
 bool BenchmarkSceneFromName(const std::string& name, BenchmarkScene* scene);
 void ApplyScene(const BenchmarkScene& scene, SyntheticRigOptions* options);
 

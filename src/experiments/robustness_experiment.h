@@ -1,8 +1,8 @@
 // The paper's robustness experiment (§5.3, Table 3) and its evaluation of the
 // initial estimates (§5.4, Fig. 6) over rig presets, scenes and difficulties:
 // each cell runs the short-sequence experiment
-// (src/experiments/short_sequence_experiment.h) and the results become tables, CSV and
-// plots.
+// (src/experiments/short_sequence_experiment.h) and the results become tables,
+// CSV and plots.
 #pragma once
 
 #include <functional>
@@ -34,9 +34,7 @@ struct RobustnessOptions {
   int num_sequences = 100;
   int framesets_per_sequence = 10;
   int recording_framesets = 120;
-  std::vector<CalibrationMethod> methods = {CalibrationMethod::kRd,
-                                            CalibrationMethod::kRdRa,
-                                            CalibrationMethod::kRadial1D};
+  std::vector<CalibrationMethod> methods = RobustnessTableMethods();
   unsigned int seed = 0;
   int num_threads = -1;
 };

@@ -1,5 +1,6 @@
 #include "src/experiments/short_sequence_experiment.h"
 
+#include <colmap/util/math.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <sstream>
 
 #include "src/evaluation/evaluation.h"
+#include "src/experiments/experiment_calibration.h"
 
 namespace rig_calibrator {
 namespace {
@@ -60,15 +62,10 @@ SequenceOutcome CalibrateSequence(CalibrationMethod method,
   outcome.initial_center_error.assign(num_cameras, kInfinity);
   outcome.final_rotation_deg.assign(num_cameras, kInfinity);
   outcome.final_center_error.assign(num_cameras, kInfinity);
-  PipelineOptions pipeline;
-  pipeline.method = method;
-  pipeline.print_progress = false;
-  pipeline.num_threads = 1;
-  pipeline.seed = seed;
-  RigCalibration calibration;
-  PipelineReport report;
-  const bool success =
-      CalibrateRig(pipeline, rig.dataset, &calibration, &report);
+  const ExperimentCalibration result = CalibrateSyntheticRig(rig, method, seed);
+  const bool success = result.success;
+  const RigCalibration& calibration = result.calibration;
+  const PipelineReport& report = result.report;
   outcome.seconds = report.total_seconds;
   outcome.fell_back = report.used_method != report.requested_method;
   if (!report.initial_cam_from_rig.empty()) {
@@ -100,11 +97,9 @@ void Append(const std::vector<double>& values, std::vector<double>* all) {
 
 }  // namespace
 
-double MedianWithFailures(std::vector<double> values) {
+double MedianWithFailures(const std::vector<double>& values) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(values.begin(), values.begin() + values.size() / 2,
-                   values.end());
-  return values[values.size() / 2];
+  return colmap::Median(values);
 }
 
 double ShortSequenceResult::PercentComplete() const {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "src/calibration/pipeline.h"
+#include "src/experiments/paper_methods.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
@@ -21,9 +22,7 @@ struct ShortSequenceOptions {
   int frameset_stride = 2;
   double good_rotation_deg = 1.0;
   double good_center_error = 0.01;  // map units (metres for metric maps)
-  std::vector<CalibrationMethod> methods = {CalibrationMethod::kRd,
-                                            CalibrationMethod::kRdRa,
-                                            CalibrationMethod::kRadial1D};
+  std::vector<CalibrationMethod> methods = RobustnessTableMethods();
   unsigned int seed = 0;
   // Sequences are calibrated in parallel, each on one thread (-1: all
   // cores); results do not depend on it.
@@ -63,8 +62,9 @@ std::vector<ShortSequenceResult> RunShortSequenceExperiment(
 std::string FormatShortSequenceResults(
     const std::vector<ShortSequenceResult>& results);
 
-// The median of the finite values and infinity for failures, as they rank
-// (NaN for no values).
-double MedianWithFailures(std::vector<double> values);
+// The median (colmap::Median: the mean of the two middle values for an even
+// count) with failures as infinity, ranking above every error: infinity when
+// at least half failed; NaN for no values.
+double MedianWithFailures(const std::vector<double>& values);
 
 }  // namespace rig_calibrator

@@ -1,16 +1,16 @@
 #include "src/evaluation/evaluation.h"
 
+#include <colmap/util/math.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // cam_from_rig of a camera turned by `rotation` (applied in the camera
 // frame) and moved by `center_offset` (in the rig frame).
@@ -103,7 +103,7 @@ TEST(Evaluation, KnownPerturbationIsMeasuredBack) {
   const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -1.0, 0.5).normalized();
   cam_from_rig[k] =
       Perturb(cam_from_rig[k],
-              Eigen::AngleAxisd(0.1 * kDegToRad, axis).toRotationMatrix(),
+              Eigen::AngleAxisd(colmap::DegToRad(0.1), axis).toRotationMatrix(),
               0.003 * Eigen::Vector3d(0.6, 0.0, 0.8));
   ScaleFocal(1.01, &cameras[k]);
   cameras[k].SetPrincipalPointX(cameras[k].PrincipalPointX() + 2);
@@ -141,7 +141,7 @@ TEST(Evaluation, AllCameraAlignmentIsTheChordalMean) {
   const RigGroundTruth truth = MakeRigPreset(RigPreset::kRing5);
   std::vector<Rigid3d> cam_from_rig = truth.cam_from_rig;
   const int k = 3;
-  const double theta = 0.1 * kDegToRad;
+  const double theta = colmap::DegToRad(0.1);
   const Eigen::Vector3d axis = Eigen::Vector3d(1.0, 0.2, -0.4).normalized();
   cam_from_rig[k] = Perturb(cam_from_rig[k],
                             Eigen::AngleAxisd(theta, axis).toRotationMatrix(),
@@ -163,7 +163,7 @@ TEST(Evaluation, AllCameraAlignmentIsTheChordalMean) {
   for (int i = 0; i < 5; ++i) {
     SCOPED_TRACE(i);
     EXPECT_NEAR(error.cameras[i].rotation_deg,
-                (i == k ? theta - phi : phi) / kDegToRad, 1e-9);
+                colmap::RadToDeg(i == k ? theta - phi : phi), 1e-9);
     const Eigen::Vector3d offset = truth.cam_from_rig[i].Center() - mean_center;
     EXPECT_NEAR(error.cameras[i].center_error,
                 (alignment * offset - offset).norm(), 1e-12);
@@ -185,63 +185,56 @@ TEST(Evaluation, AllCameraAlignmentMatchesCentroids) {
   }
 }
 
-TEST(Evaluation, WholeRigTransformIsRemoved) {
-  const Rigid3d rig_from_rigest(
-      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())
-          .toRotationMatrix(),
-      Eigen::Vector3d(0.5, -1.2, 2.0));
+// Every preset's rig expressed in another rig frame, scaled by `scale`:
+// both alignments remove the change (with scale alignment when scale != 1);
+// without scale alignment a scaled rig stays off.
+void ExpectRigFrameChangeRemoved(const Rigid3d& rig_from_rigest, double scale) {
+  const bool align_scale = scale != 1.0;
   for (const RigPreset preset : AllRigPresets()) {
     SCOPED_TRACE(RigPresetName(preset));
     const RigGroundTruth truth = MakeRigPreset(preset);
     const std::vector<Rigid3d> moved =
-        ChangeRigFrame(truth.cam_from_rig, rig_from_rigest, 1.0);
+        ChangeRigFrame(truth.cam_from_rig, rig_from_rigest, scale);
+    // The change is not a no-op.
+    EXPECT_GT(RotationDifferenceDeg(moved[0].rotation,
+                                    truth.cam_from_rig[0].rotation),
+              20);
     for (const RigAlignment alignment :
          {RigAlignment::kAllCameras, RigAlignment::kReferenceCamera}) {
       CompareOptions options;
       options.alignment = alignment;
+      options.align_scale = align_scale;
       const CalibrationError error = CompareCalibrations(
           truth.cameras, truth.cam_from_rig, truth.cameras, moved, options);
       ASSERT_TRUE(error.ok());
+      EXPECT_NEAR(error.scale, 1 / scale, 1e-12);
       EXPECT_LT(error.MaxRotationDeg(), 1e-9);
       EXPECT_LT(error.MaxCenterError(), 1e-12);
+      if (align_scale) {
+        options.align_scale = false;
+        const CalibrationError unscaled = CompareCalibrations(
+            truth.cameras, truth.cam_from_rig, truth.cameras, moved, options);
+        EXPECT_EQ(unscaled.scale, 1.0);
+        EXPECT_GT(unscaled.MaxCenterError(), 0.03);
+      }
     }
-    // Without alignment the moved rig would be far off: check that the
-    // transform was not a no-op.
-    EXPECT_GT(RotationDifferenceDeg(moved[0].rotation,
-                                    truth.cam_from_rig[0].rotation),
-              30);
   }
 }
 
-TEST(Evaluation, GlobalScaleIsRemovedWithScaleAlignment) {
-  const Rigid3d rig_from_rigest(
-      Eigen::AngleAxisd(-0.4, Eigen::Vector3d(0, 1, 1).normalized())
-          .toRotationMatrix(),
-      Eigen::Vector3d(-0.3, 0.1, 0.9));
-  for (const RigPreset preset : AllRigPresets()) {
-    SCOPED_TRACE(RigPresetName(preset));
-    const RigGroundTruth truth = MakeRigPreset(preset);
-    const std::vector<Rigid3d> scaled =
-        ChangeRigFrame(truth.cam_from_rig, rig_from_rigest, 1.7);
-    for (const RigAlignment alignment :
-         {RigAlignment::kAllCameras, RigAlignment::kReferenceCamera}) {
-      CompareOptions options;
-      options.alignment = alignment;
-      options.align_scale = true;
-      const CalibrationError error = CompareCalibrations(
-          truth.cameras, truth.cam_from_rig, truth.cameras, scaled, options);
-      ASSERT_TRUE(error.ok());
-      EXPECT_NEAR(error.scale, 1 / 1.7, 1e-12);
-      EXPECT_LT(error.MaxRotationDeg(), 1e-9);
-      EXPECT_LT(error.MaxCenterError(), 1e-12);
+TEST(Evaluation, WholeRigTransformIsRemoved) {
+  ExpectRigFrameChangeRemoved(
+      Rigid3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())
+                  .toRotationMatrix(),
+              Eigen::Vector3d(0.5, -1.2, 2.0)),
+      1.0);
+}
 
-      options.align_scale = false;
-      const CalibrationError unscaled = CompareCalibrations(
-          truth.cameras, truth.cam_from_rig, truth.cameras, scaled, options);
-      EXPECT_EQ(unscaled.scale, 1.0);
-      EXPECT_GT(unscaled.MaxCenterError(), 0.03);
-    }
-  }
+TEST(Evaluation, GlobalScaleIsRemovedWithScaleAlignment) {
+  ExpectRigFrameChangeRemoved(
+      Rigid3d(Eigen::AngleAxisd(-0.4, Eigen::Vector3d(0, 1, 1).normalized())
+                  .toRotationMatrix(),
+              Eigen::Vector3d(-0.3, 0.1, 0.9)),
+      1.7);
 }
 
 // Scaling f by 1.01 moves every pixel radially away from the principal
@@ -364,8 +357,15 @@ TEST(Evaluation, TableAndJsonReportEveryCamera) {
   EXPECT_NE(table.find("front"), std::string::npos);
   EXPECT_NE(table.find("left"), std::string::npos);
   EXPECT_NE(table.find("cam4"), std::string::npos);
-  EXPECT_NE(table.find("2.000"), std::string::npos);
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 1 + 5 + 2);
+  // The cam4 row read back: rotation, center, focal (%) columns.
+  std::istringstream cam4_row(table.substr(table.find("cam4")));
+  std::string name;
+  double rotation_deg = -1, center = -1, focal_percent = -1;
+  cam4_row >> name >> rotation_deg >> center >> focal_percent;
+  EXPECT_EQ(name, "cam4");
+  EXPECT_NEAR(rotation_deg, 0, 1e-4);
+  EXPECT_NEAR(focal_percent, error.cameras[4].focal_error_percent, 1e-3);
 
   const nlohmann::json json = CalibrationErrorToJson(error, truth.camera_names);
   ASSERT_EQ(json["cameras"].size(), 5);

@@ -1,0 +1,25 @@
+// Which correspondences a stage of the pipeline uses: those that the current
+// rig explains. Every image of a posed frameset (calibrated camera, rig pose)
+// gets its inlier mask; images of other framesets get none. This also brings
+// in images that could not be localized on their own but whose frameset was
+// posed by the other cameras.
+#pragma once
+
+#include "src/calibration/rig_dataset.h"
+
+namespace rig_calibrator {
+
+// The image's camera is calibrated and its frameset has a rig pose.
+bool FramesetPosed(const RigCalibration& calibration, const RigImage& image);
+
+// Inliers of the radial rig: radial reprojection error (about the camera's
+// current principal point) below max_error_px.
+void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
+                         RigCalibration* calibration);
+
+// Inliers of the full calibration: in front of the camera and reprojected
+// within max_error_px.
+void SelectFullInliers(const RigDataset& dataset, double max_error_px,
+                       RigCalibration* calibration);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,288 @@
+#include "src/calibration/pipeline_stages.h"
+
+#include <colmap/util/math.h>
+
+#include <algorithm>
+#include <iostream>
+#include <utility>
+
+#include "src/calibration/complete_frameset_initialization.h"
+#include "src/calibration/inlier_selection.h"
+
+namespace rig_calibrator {
+namespace {
+
+RigInitializerOptions RigInitializerOptionsFor(const PipelineOptions& options,
+                                               bool radial) {
+  RigInitializerOptions init_options = options.rig_initializer;
+  init_options.radial = radial;
+  init_options.num_threads = options.num_threads;
+  init_options.seed = options.seed;
+  return init_options;
+}
+
+// The camera upgrade's input for one camera: its radial inliers pooled over
+// all its images of posed framesets, the map points in the camera frame, and
+// where each row came from.
+struct UpgradeInput {
+  std::vector<Eigen::Vector2d> points2D;
+  std::vector<Eigen::Vector3d> points_cam;
+  std::vector<std::pair<int, int>> rows;  // (image, correspondence)
+};
+
+UpgradeInput GatherUpgradeInput(const RigDataset& dataset,
+                                const RigCalibration& calibration, int camera) {
+  UpgradeInput input;
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const RigImage& image = dataset.images[i];
+    if (image.camera_index != camera || !FramesetPosed(calibration, image)) {
+      continue;
+    }
+    const Rigid3d cam_from_world =
+        calibration.CamFromWorld(camera, image.frameset_index);
+    for (size_t k = 0; k < image.correspondences.size(); ++k) {
+      if (!calibration.images[i].inlier_mask[k]) continue;
+      input.points2D.push_back(image.correspondences[k].point2D);
+      input.points_cam.push_back(cam_from_world *
+                                 image.correspondences[k].point3D);
+      input.rows.emplace_back(static_cast<int>(i), static_cast<int>(k));
+    }
+  }
+  return input;
+}
+
+// A successful upgrade of `camera`: its forward offset, and as inliers of its
+// images exactly the upgrade's inliers.
+void ApplyUpgrade(const RigDataset& dataset, int camera,
+                  const UpgradeInput& input, const CameraUpgradeResult& result,
+                  RigCalibration* calibration) {
+  calibration->cam_from_rig[camera].translation.z() = result.tz;
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    if (dataset.images[i].camera_index != camera) continue;
+    calibration->images[i].inlier_mask.assign(
+        dataset.images[i].correspondences.size(), 0);
+    calibration->images[i].num_inliers = 0;
+  }
+  for (size_t r = 0; r < input.rows.size(); ++r) {
+    if (!result.inlier_mask[r]) continue;
+    ImageResult& image = calibration->images[input.rows[r].first];
+    image.inlier_mask[input.rows[r].second] = 1;
+    ++image.num_inliers;
+  }
+}
+
+// Diagnostics and progress of one camera's upgrade.
+void ReportUpgrade(const PipelineOptions& options, const RigDataset& dataset,
+                   int camera, const UpgradeInput& input, bool success,
+                   const CameraUpgradeResult& result,
+                   const RigCalibration& calibration, PipelineReport* report) {
+  const std::string& name = dataset.cameras[camera].name;
+  if (!success) {
+    AddDiagnostic(report, Diagnostic::Level::kWarning, "upgrade_failed",
+                  "the intrinsics of camera " + name +
+                      " could not be estimated from its " +
+                      std::to_string(input.rows.size()) +
+                      " radial inliers: " + result.error_message,
+                  {camera});
+    return;
+  }
+  if (!result.well_conditioned) {
+    AddDiagnostic(report, Diagnostic::Level::kWarning,
+                  "focal_tz_ill_conditioned",
+                  "camera " + name +
+                      ": focal length and forward offset are poorly separated "
+                      "(correlation " +
+                      std::to_string(result.tz_focal_correlation) +
+                      "); the scene seen by this camera has too little depth "
+                      "variation. Record closer and farther structure.",
+                  {camera});
+  }
+  if (options.print_progress) {
+    const colmap::Camera& intrinsics = calibration.cameras[camera];
+    std::cout << "  " << name << ": " << result.num_inliers << " inliers, tz "
+              << result.tz << ", " << intrinsics.ModelName() << " "
+              << intrinsics.ParamsToString() << ", RMS " << result.rms_px
+              << " px" << std::endl;
+  }
+}
+
+// Paper §3.5: per camera, all its frames pooled, the forward translation tz
+// and the intrinsics of its model from the radial rig. Cameras are upgraded
+// in parallel; the results are applied in camera order.
+void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
+                    RigCalibration* calibration, PipelineReport* report) {
+  const int num_cameras = static_cast<int>(dataset.cameras.size());
+  std::vector<UpgradeInput> inputs(num_cameras);
+  std::vector<CameraUpgradeResult> results(num_cameras);
+  std::vector<char> success(num_cameras, 0);
+#pragma omp parallel for schedule(dynamic) num_threads( \
+    std::max(1, options.num_threads > 0 ? options.num_threads : num_cameras))
+  for (int c = 0; c < num_cameras; ++c) {
+    if (!calibration->camera_calibrated[c]) continue;
+    inputs[c] = GatherUpgradeInput(dataset, *calibration, c);
+    success[c] =
+        UpgradeCamera(options.upgrade, inputs[c].points2D, inputs[c].points_cam,
+                      &calibration->cameras[c], &results[c]);
+  }
+  for (int c = 0; c < num_cameras; ++c) {
+    if (!calibration->camera_calibrated[c]) continue;
+    if (success[c]) {
+      ApplyUpgrade(dataset, c, inputs[c], results[c], calibration);
+    } else {
+      calibration->camera_calibrated[c] = false;
+    }
+    ReportUpgrade(options, dataset, c, inputs[c], success[c], results[c],
+                  *calibration, report);
+  }
+}
+
+// The rig frame is the reference camera's frame. The radial stages fix the
+// reference camera's tz at 0; after the upgrade it has a forward offset,
+// which moves into the rig poses: P_i <- P_i P_ref^-1, Q_j <- P_ref Q_j.
+void AnchorRigAtReferenceCamera(int reference_camera,
+                                RigCalibration* calibration) {
+  const Rigid3d ref_from_rig = calibration->cam_from_rig[reference_camera];
+  const Rigid3d rig_from_ref = ref_from_rig.Inverse();
+  for (Rigid3d& cam_from_rig : calibration->cam_from_rig) {
+    cam_from_rig = cam_from_rig * rig_from_ref;
+  }
+  calibration->cam_from_rig[reference_camera] = Rigid3d();
+  for (std::optional<Rigid3d>& rig_from_world : calibration->rig_from_world) {
+    if (rig_from_world) rig_from_world = ref_from_rig * *rig_from_world;
+  }
+}
+
+// Per-camera intrinsics for the full-pose methods that estimate them per
+// image: the element-wise median (colmap::Median: the mean of the two middle
+// values for an even count) of the localized images' parameters.
+void MedianIntrinsics(const RigDataset& dataset,
+                      const std::vector<colmap::Camera>& per_image_cameras,
+                      RigCalibration* calibration) {
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    std::vector<std::vector<double>> values;
+    for (size_t i = 0; i < dataset.images.size(); ++i) {
+      if (dataset.images[i].camera_index != static_cast<int>(c) ||
+          !calibration->images[i].localized) {
+        continue;
+      }
+      const std::vector<double>& params = per_image_cameras[i].Params();
+      if (values.empty()) values.resize(params.size());
+      for (size_t p = 0; p < params.size(); ++p) values[p].push_back(params[p]);
+    }
+    if (values.empty()) continue;
+    std::vector<double> median(values.size());
+    for (size_t p = 0; p < values.size(); ++p) {
+      median[p] = colmap::Median(values[p]);
+    }
+    calibration->cameras[c].SetParams(median);
+  }
+}
+
+}  // namespace
+
+bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
+                     RigCalibration* calibration, PipelineReport* report) {
+  {
+    StageTimer stage("Radial rig initialization", options.print_progress,
+                     report);
+    RigInitializerSummary summary;
+    if (!InitializeRig(RigInitializerOptionsFor(options, /*radial=*/true),
+                       dataset, calibration, &summary)) {
+      report->error =
+          "the radial rig initialization failed: " + summary.message;
+      return false;
+    }
+  }
+  {
+    StageTimer stage("Radial bundle adjustment", options.print_progress,
+                     report);
+    RadialBundleAdjustmentOptions ba_options = options.radial_bundle_adjustment;
+    ba_options.num_threads = options.num_threads;
+    RadialBundleAdjustmentSummary summary;
+    if (!AdjustRadialRig(ba_options, dataset, calibration, &summary)) {
+      report->error = "the radial bundle adjustment failed (see above)";
+      return false;
+    }
+    if (options.print_progress) {
+      std::cout << "  radial RMS " << summary.initial_rms_px << " -> "
+                << summary.final_rms_px << " px over " << summary.num_residuals
+                << " residuals, " << summary.num_iterations << " iterations"
+                << std::endl;
+    }
+  }
+  StageTimer stage("Camera upgrade", options.print_progress, report);
+  SelectRadialInliers(dataset, options.upgrade_radial_max_error_px,
+                      calibration);
+  UpgradeCameras(options, dataset, calibration, report);
+  if (!calibration->camera_calibrated[dataset.reference_camera]) {
+    report->error = "the reference camera " +
+                    dataset.cameras[dataset.reference_camera].name +
+                    " could not be upgraded; choose another reference camera";
+    return false;
+  }
+  AnchorRigAtReferenceCamera(dataset.reference_camera, calibration);
+  return true;
+}
+
+bool RunFullPoseRigInitialization(
+    const PipelineOptions& options, CalibrationMethod method,
+    const RigDataset& dataset,
+    const std::vector<colmap::Camera>& per_image_cameras,
+    RigCalibration* calibration, PipelineReport* report) {
+  StageTimer stage("Rig initialization", options.print_progress, report);
+  if (!UsesKnownIntrinsics(method)) {
+    MedianIntrinsics(dataset, per_image_cameras, calibration);
+  }
+  std::string error;
+  if (UsesCompleteFramesetInitialization(method)) {
+    if (InitializeRigFromCompleteFrameset(dataset, calibration, &error)) {
+      return true;
+    }
+    report->error =
+        "method " + CalibrationMethodName(method) +
+        " takes the rig from a frameset in which every camera was localized, "
+        "and " +
+        error + ": use " +
+        (UsesKnownIntrinsics(method) ? "known_ra" : "rd_ra or 1dr") +
+        ", which need no complete frameset";
+    return false;
+  }
+  RigInitializerSummary summary;
+  if (!InitializeRig(RigInitializerOptionsFor(options, /*radial=*/false),
+                     dataset, calibration, &summary)) {
+    report->error = "the rig initialization failed: " + summary.message;
+    return false;
+  }
+  return true;
+}
+
+bool RunFinalBundleAdjustment(const PipelineOptions& options,
+                              CalibrationMethod method,
+                              const RigDataset& dataset,
+                              RigCalibration* calibration,
+                              PipelineReport* report) {
+  StageTimer stage("Final bundle adjustment", options.print_progress, report);
+  SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
+  FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
+  ba_options.num_threads = options.num_threads;
+  if (!RefinesIntrinsics(method)) {
+    ba_options.refine_focal_length = false;
+    ba_options.refine_principal_point = false;
+    ba_options.refine_extra_params = false;
+  }
+  FinalBundleAdjustmentSummary summary;
+  if (!AdjustRig(ba_options, dataset, calibration, &summary)) {
+    report->error = "the final bundle adjustment failed (see above)";
+    return false;
+  }
+  report->final_rms_px = summary.final_rms_px;
+  if (options.print_progress) {
+    std::cout << "  RMS " << summary.initial_rms_px << " -> "
+              << summary.final_rms_px << " px over " << summary.num_residuals
+              << " residuals, " << summary.num_outliers << " outliers removed, "
+              << summary.num_iterations << " iterations" << std::endl;
+  }
+  return true;
+}
+
+}  // namespace rig_calibrator

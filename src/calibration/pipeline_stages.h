@@ -1,0 +1,36 @@
+// The stages of CalibrateRig (pipeline.h) after the single-image
+// localization, each timed and reported: the radial stages of 1dr (paper
+// §3.3-3.5), the rig initialization of the full-pose methods, and the final
+// bundle adjustment (§3.6). Each returns false with report->error set when
+// the calibration cannot go on.
+#pragma once
+
+#include <vector>
+
+#include "src/calibration/pipeline.h"
+
+namespace rig_calibrator {
+
+// 1dr: robust radial rig initialization, radial bundle adjustment, camera
+// upgrade of every camera; the rig is then anchored at the reference camera.
+bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
+                     RigCalibration* calibration, PipelineReport* report);
+
+// The full-pose methods: per-camera intrinsics (the median over the images,
+// rd and rd_ra; given, known*) and the rig, from the best complete frameset
+// (known, known_refine, rd) or robustly (rd_ra, known_ra).
+bool RunFullPoseRigInitialization(
+    const PipelineOptions& options, CalibrationMethod method,
+    const RigDataset& dataset,
+    const std::vector<colmap::Camera>& per_image_cameras,
+    RigCalibration* calibration, PipelineReport* report);
+
+// The final bundle adjustment over the full inliers of the current rig;
+// the intrinsics are held for known and known_ra.
+bool RunFinalBundleAdjustment(const PipelineOptions& options,
+                              CalibrationMethod method,
+                              const RigDataset& dataset,
+                              RigCalibration* calibration,
+                              PipelineReport* report);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,112 @@
+// The state of the final bundle adjustment (final_bundle_adjuster.h) between
+// its solves: copies of the calibration being refined (written back only on
+// success), the observations that take part, and the map points being
+// refined. Internal to AdjustRig; split over
+//   rig_adjustment.cc           state, evaluation, point selection, results,
+//   rig_adjustment_outliers.cc  outlier pruning,
+//   rig_adjustment_problem.cc   the Ceres problem and its solve.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <array>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "src/calibration/final_bundle_adjuster.h"
+#include "src/calibration/rig_dataset.h"
+
+namespace rig_calibrator {
+
+// A pose as one Ceres parameter block, [qw, qx, qy, qz, tx, ty, tz] (the
+// layout of RigReprojectionCost), so that a rig pose is a single block of the
+// Schur elimination group.
+using PoseParams = std::array<double, 7>;
+PoseParams ToPoseParams(const Rigid3d& pose);
+Rigid3d FromPoseParams(const PoseParams& params);
+
+class RigAdjustment {
+ public:
+  // The observations are the inliers (inlier_mask) of the images of
+  // calibrated cameras in framesets with a rig pose.
+  RigAdjustment(const FinalBundleAdjustmentOptions& options,
+                const RigDataset& dataset, const RigCalibration& calibration);
+
+  size_t NumObservations() const { return observations_.size(); }
+  // Given inliers removed since the construction.
+  size_t NumRejected() const {
+    return num_given_inliers_ - observations_.size();
+  }
+  // Whether the last solve held some observed point fixed (a point without
+  // id, or seen once): such points anchor the world frame and scale.
+  bool HasFixedPoints() const { return has_fixed_points_; }
+
+  // RMS of |r| over the current observations at the current estimate.
+  double RmsError() const;
+
+  // Removes observations behind their camera or farther than
+  // max_depth_factor * the median depth; with `prune_residuals` also those
+  // whose error exceeds their camera's threshold (see the options). Returns
+  // how many were removed.
+  size_t RejectOutliers(bool prune_residuals);
+
+  // Builds the problem over the current observations and solves it. False
+  // (logged) when Ceres finds no usable solution.
+  bool Solve(ceres::Solver::Summary* summary);
+
+  // Writes the estimate and the per-image results (see AdjustRig).
+  void WriteTo(RigCalibration* calibration) const;
+
+ private:
+  // One correspondence of one dataset image.
+  struct Observation {
+    int image = -1;
+    int correspondence = -1;
+  };
+  // Where a point is and its residual at the current estimate.
+  struct ObservationError {
+    double depth = 0;  // z in the camera frame
+    Eigen::Vector2d residual = Eigen::Vector2d::Zero();
+  };
+
+  const Correspondence& CorrespondenceOf(const Observation& observation) const;
+  int CameraOf(const Observation& observation) const;
+  ObservationError Evaluate(const Observation& observation) const;
+  // The refined position of the observed point, else its map position.
+  const Eigen::Vector3d& PointOf(const Correspondence& correspondence) const;
+  bool IsPointRefined(const Correspondence& correspondence) const;
+  // The points to refine in the next solve: those with an id that the
+  // current observations see at least twice (seen once, a point has 3
+  // unknowns for 2 residuals). They keep their refined position from an
+  // earlier solve, or start at their map position.
+  void SelectRefinedPoints();
+  // Per camera, max(min_outlier_error_px, outlier_sigma_factor * sigma),
+  // sigma the robust spread of the residual components of the camera's
+  // observations in front of it.
+  std::vector<double> MaxErrorPerCamera(
+      const std::vector<ObservationError>& errors) const;
+
+  void AddResidualBlocks(ceres::Problem* problem);
+  void SetUpParameterBlocks(ceres::Problem* problem);
+  ceres::Solver::Options SolverOptions(const ceres::Problem& problem);
+
+  const FinalBundleAdjustmentOptions& options_;
+  const RigDataset& dataset_;
+  std::vector<colmap::Camera> cameras_;
+  std::vector<PoseParams> cam_from_rig_;
+  std::vector<PoseParams> rig_from_world_;
+  std::vector<bool> has_rig_pose_;
+  std::vector<Observation> observations_;
+  size_t num_given_inliers_ = 0;
+  // By point3D_id: the map positions and the points being refined.
+  std::unordered_map<int64_t, Eigen::Vector3d> map_points_;
+  std::unordered_map<int64_t, Eigen::Vector3d> refined_points_;
+  bool has_fixed_points_ = false;
+  // Ceres does not own these; they outlive every problem built here.
+  std::unique_ptr<ceres::LossFunction> loss_;
+  std::unique_ptr<ceres::Manifold> pose_manifold_;
+  std::vector<std::unique_ptr<ceres::Manifold>> intrinsics_manifolds_;
+};
+
+}  // namespace rig_calibrator

@@ -1,0 +1,189 @@
+// The cost of the final bundle adjustment (paper §3.6): the reprojection
+// error of a map point X seen by camera i of a rig in frameset j,
+//
+//   r = pi_theta(P Q X) - x   (pixels, 2 residuals),
+//
+// Q = rig_from_world of the frameset, P = cam_from_rig of the camera, theta
+// the camera's COLMAP model parameters, pi_theta the model's projection of
+// the normalized point (u, v) = (p_x / p_z, p_y / p_z) of p = P Q X, x the
+// observed keypoint.
+//
+// Parameter blocks, in order: Q and P as [qw, qx, qy, qz, tx, ty, tz] (for
+// ceres::QuaternionManifold x R^3: one block per pose, so that a rig pose is
+// a single block of the Schur elimination group), theta (the model's
+// kNumParams) and, when the point is refined, X (3).
+//
+// Jacobians. The pose and point Jacobians are analytic, by the chain rule
+// through p = R_P (R_Q X + t_Q) + t_P:
+//   dr/dp   = dpi/d(u,v) [1/z, 0, -u/z; 0, 1/z, -v/z],
+//   dr/dt_P = dr/dp,                    dr/dq_P = dr/dp  dR(q_P) y / dq_P,
+//   dr/dt_Q = dr/dp R_P,                dr/dq_Q = dr/dp R_P dR(q_Q) X / dq_Q,
+//   dr/dX   = dr/dp R_P R_Q,
+// with y = R_Q X + t_Q and dR(q) p / dq from RotatedPointQuaternionJacobian.
+// Only pi_theta is differentiated with Jets (2 + kNumParams derivatives
+// instead of the 17 + kNumParams of a fully auto-differentiated functor):
+// the Jacobian evaluation dominates the final bundle adjustment.
+// A point that is not in front of the camera (p_z <= 0) is an invalid
+// evaluation for Ceres (the step is rejected), not a NaN.
+#pragma once
+
+#include <ceres/cost_function.h>
+#include <ceres/jet.h>
+#include <colmap/base/pose.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace rig_calibrator {
+
+// d(R(q) p)/dq for a unit quaternion q = (w, v), as a 3 x 4 matrix over
+// (w, v_x, v_y, v_z): from
+//   R(q) p = p + 2 w (v x p) + 2 v x (v x p),
+//   d/dw = 2 v x p,  d/dv = -2 w [p]x + 2 (v p^T + (v.p) I - 2 p v^T).
+// Ceres' QuaternionManifold maps it to the 3 tangent directions. Inline: it
+// runs twice per residual evaluation.
+inline Eigen::Matrix<double, 3, 4> RotatedPointQuaternionJacobian(
+    const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d v = q.vec();
+  Eigen::Matrix<double, 3, 4> jacobian;
+  jacobian.col(0) = 2 * v.cross(p);
+  jacobian.rightCols<3>() =
+      -2 * q.w() * colmap::CrossProductMatrix(p) +
+      2 * (v * p.transpose() + v.dot(p) * Eigen::Matrix3d::Identity() -
+           2 * p * v.transpose());
+  return jacobian;
+}
+
+// The pixel pi_theta(u, v) of the COLMAP model CameraModel, with its
+// derivatives by (u, v) and, when `d_pixel_d_params` is given, by theta
+// (row-major 2 x kNumParams): forward-mode differentiation of the templated
+// CameraModel::WorldToImage with kNumDerivatives = 2 (u, v) or
+// 2 + kNumParams.
+template <typename CameraModel, int kNumDerivatives>
+void ProjectWithJacobians(const double* params, double u, double v,
+                          double* pixel, Eigen::Matrix2d* d_pixel_d_uv,
+                          double* d_pixel_d_params) {
+  using Jet = ceres::Jet<double, kNumDerivatives>;
+  constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
+  Jet jet_params[kNumParams];
+  for (int k = 0; k < kNumParams; ++k) {
+    jet_params[k] =
+        kNumDerivatives > 2 ? Jet(params[k], 2 + k) : Jet(params[k]);
+  }
+  Jet x, y;
+  CameraModel::WorldToImage(jet_params, Jet(u, 0), Jet(v, 1), &x, &y);
+  pixel[0] = x.a;
+  pixel[1] = y.a;
+  *d_pixel_d_uv << x.v[0], x.v[1], y.v[0], y.v[1];
+  if (d_pixel_d_params != nullptr) {
+    for (int k = 0; k < kNumParams; ++k) {
+      d_pixel_d_params[k] = x.v[2 + k];
+      d_pixel_d_params[kNumParams + k] = y.v[2 + k];
+    }
+  }
+}
+
+// r = pi_theta(P Q X) - x for the COLMAP model CameraModel (see the top of
+// the file); X is a fixed point given at construction or the fourth block.
+template <typename CameraModel>
+class RigReprojectionCost final : public ceres::CostFunction {
+ public:
+  static constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
+
+  // `point3D` null: the point is the fourth parameter block.
+  RigReprojectionCost(const Eigen::Vector2d& observed,
+                      const Eigen::Vector3d* point3D)
+      : observed_(observed),
+        fixed_point3D_(point3D != nullptr ? *point3D : Eigen::Vector3d::Zero()),
+        variable_point_(point3D == nullptr) {
+    set_num_residuals(2);
+    *mutable_parameter_block_sizes() = {7, 7, kNumParams};
+    if (variable_point_) {
+      mutable_parameter_block_sizes()->push_back(3);
+    }
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* rig_from_world = parameters[0];
+    const double* cam_from_rig = parameters[1];
+    const double* camera_params = parameters[2];
+    const Eigen::Quaterniond rig_rotation(rig_from_world[0], rig_from_world[1],
+                                          rig_from_world[2], rig_from_world[3]);
+    const Eigen::Quaterniond cam_rotation(cam_from_rig[0], cam_from_rig[1],
+                                          cam_from_rig[2], cam_from_rig[3]);
+    const Eigen::Matrix3d rig_rotation_matrix = rig_rotation.toRotationMatrix();
+    const Eigen::Matrix3d cam_rotation_matrix = cam_rotation.toRotationMatrix();
+    const Eigen::Vector3d point3D =
+        variable_point_ ? Eigen::Vector3d(parameters[3]) : fixed_point3D_;
+    const Eigen::Vector3d point_in_rig =
+        rig_rotation_matrix * point3D + Eigen::Vector3d(rig_from_world + 4);
+    const Eigen::Vector3d point_in_cam =
+        cam_rotation_matrix * point_in_rig + Eigen::Vector3d(cam_from_rig + 4);
+    const double z = point_in_cam.z();
+    if (!(z > 0)) {
+      return false;
+    }
+    const double u = point_in_cam.x() / z;
+    const double v = point_in_cam.y() / z;
+    if (jacobians == nullptr) {
+      CameraModel::WorldToImage(camera_params, u, v, &residuals[0],
+                                &residuals[1]);
+      residuals[0] -= observed_.x();
+      residuals[1] -= observed_.y();
+      return true;
+    }
+
+    Eigen::Matrix2d d_pixel_d_uv;
+    if (jacobians[2] != nullptr) {
+      ProjectWithJacobians<CameraModel, 2 + kNumParams>(
+          camera_params, u, v, residuals, &d_pixel_d_uv, jacobians[2]);
+    } else {
+      ProjectWithJacobians<CameraModel, 2>(camera_params, u, v, residuals,
+                                           &d_pixel_d_uv, nullptr);
+    }
+    residuals[0] -= observed_.x();
+    residuals[1] -= observed_.y();
+
+    Eigen::Matrix<double, 2, 3> d_pixel_d_cam;
+    d_pixel_d_cam.col(0) = d_pixel_d_uv.col(0) / z;
+    d_pixel_d_cam.col(1) = d_pixel_d_uv.col(1) / z;
+    d_pixel_d_cam.col(2) =
+        -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
+    using PoseJacobian = Eigen::Matrix<double, 2, 7, Eigen::RowMajor>;
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<PoseJacobian> jacobian(jacobians[1]);
+      jacobian.leftCols<4>() = d_pixel_d_cam * RotatedPointQuaternionJacobian(
+                                                   cam_rotation, point_in_rig);
+      jacobian.rightCols<3>() = d_pixel_d_cam;
+    }
+    const Eigen::Matrix<double, 2, 3> d_pixel_d_rig =
+        d_pixel_d_cam * cam_rotation_matrix;
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<PoseJacobian> jacobian(jacobians[0]);
+      jacobian.leftCols<4>() =
+          d_pixel_d_rig * RotatedPointQuaternionJacobian(rig_rotation, point3D);
+      jacobian.rightCols<3>() = d_pixel_d_rig;
+    }
+    if (variable_point_ && jacobians[3] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(
+          jacobians[3]);
+      jacobian = d_pixel_d_rig * rig_rotation_matrix;
+    }
+    return true;
+  }
+
+ private:
+  const Eigen::Vector2d observed_;
+  const Eigen::Vector3d fixed_point3D_;
+  const bool variable_point_;
+};
+
+// RigReprojectionCost for the COLMAP camera model `model_id`, observing
+// `observed` (pixels); `point3D` fixed, or null for a refined point. Null
+// for an unknown model id. The caller owns the result.
+ceres::CostFunction* CreateRigReprojectionCost(int model_id,
+                                               const Eigen::Vector2d& observed,
+                                               const Eigen::Vector3d* point3D);
+
+}  // namespace rig_calibrator
