@@ -11,6 +11,7 @@
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
+#include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
 
@@ -99,14 +100,10 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
     }
   }
 
-  colmap::camera_t max_camera_id = 0;
-  for (const auto& [camera_id, camera] : map.Cameras()) {
-    max_camera_id = std::max(max_camera_id, camera_id);
-  }
-  colmap::image_t max_image_id = 0;
+  const colmap::camera_t max_camera_id = MaxCameraId(map);
+  const colmap::image_t max_image_id = MaxImageId(map);
   std::unordered_set<std::string> map_names;
   for (const auto& [image_id, image] : map.Images()) {
-    max_image_id = std::max(max_image_id, image_id);
     map_names.insert(image.Name());
   }
   // Keep clear of kInvalidCameraId/kInvalidImageId (the uint32 maximum) and
