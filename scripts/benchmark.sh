@@ -10,13 +10,9 @@
 # The build folder is $RIG_CALIBRATOR_BUILD_DIR, else build/ (scripts/build.sh).
 set -euo pipefail
 
-die() {
-  echo "ERROR: $*" >&2
-  exit 1
-}
-
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+log_tag=benchmark
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 quick=0
 if [[ "${1:-}" == "--quick" ]]; then
   quick=1
@@ -24,7 +20,6 @@ if [[ "${1:-}" == "--quick" ]]; then
 fi
 [[ $# -le 1 ]] || die "usage: scripts/benchmark.sh [--quick] [RESULTS_DIR]"
 results="${1:-$repo/benchmark_results}"
-rig_calibrator="$build/rig_calibrator"
 [[ -x "$rig_calibrator" ]] ||
   die "$rig_calibrator not found: build first (bash scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create the results folder $results"

@@ -20,9 +20,9 @@
 #                             framesets, fewer localized images)
 set -euo pipefail
 
-usage() {
-  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'
-}
+log_tag=benchmark_runtime
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 if [[ $# -lt 1 || "$1" == "-h" || "$1" == "--help" ]]; then
   usage >&2
@@ -31,11 +31,6 @@ fi
 results="$1"
 shift
 
-die() { echo "[benchmark_runtime] ERROR: $*" >&2; exit 1; }
-
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
-rig_calibrator="$build/rig_calibrator"
 [[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create $results"
 results="$(cd "$results" && pwd)"

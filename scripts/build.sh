@@ -3,9 +3,10 @@
 # build/ (or $RIG_CALIBRATOR_BUILD_DIR). The executable is build/rig_calibrator.
 set -euo pipefail
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+log_tag=build
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cache="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 bash "$repo/scripts/setup_deps.sh"

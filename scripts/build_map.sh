@@ -30,9 +30,9 @@
 #   MAP_NUM_THREADS        threads for every step (default: all cores)
 set -euo pipefail
 
-usage() {
-  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'
-}
+log_tag=build_map
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 if [[ $# -lt 2 || $# -gt 4 || "$1" == "-h" || "$1" == "--help" ]]; then
   usage >&2
@@ -43,10 +43,8 @@ work_dir="$2"
 ref_positions="${3:-}"
 camera_params="${4:-}"
 
-die() { echo "[build_map] ERROR: $*" >&2; exit 1; }
-
 # shellcheck source=find_colmap.sh
-source "$(dirname "${BASH_SOURCE[0]}")/find_colmap.sh"
+source "$repo/scripts/find_colmap.sh"
 
 matcher="${MAP_MATCHER:-sequential}"
 overlap="${MAP_OVERLAP:-8}"

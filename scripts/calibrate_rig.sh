@@ -21,9 +21,9 @@
 #   RIG_NUM_THREADS   feature extraction threads (default: all cores)
 set -euo pipefail
 
-usage() {
-  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'
-}
+log_tag=calibrate_rig
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 if [[ $# -lt 4 || "$1" == "-h" || "$1" == "--help" ]]; then
   usage >&2
@@ -35,12 +35,9 @@ rig_images="$3"
 out="$4"
 shift 4
 
-die() { echo "[calibrate_rig] ERROR: $*" >&2; exit 1; }
-
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # shellcheck source=find_colmap.sh
-source "$(dirname "${BASH_SOURCE[0]}")/find_colmap.sh"
-rig_calibrator="${RIG_CALIBRATOR:-$repo/build/rig_calibrator}"
+source "$repo/scripts/find_colmap.sh"
+rig_calibrator="${RIG_CALIBRATOR:-$rig_calibrator}"
 [[ -x "$rig_calibrator" ]] || die "no rig_calibrator at $rig_calibrator: build it (scripts/build.sh) or set RIG_CALIBRATOR"
 max_features="${RIG_MAX_FEATURES:-4096}"
 threads="${RIG_NUM_THREADS:--1}"

@@ -23,18 +23,15 @@
 #   scripts/build_map.sh and scripts/calibrate_rig.sh
 set -euo pipefail
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+log_tag=demo
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 out="${1:-$repo/demo_output/rendered}"
 preset="${DEMO_PRESET:-ring5}"
 scene="${DEMO_SCENE:-room}"
 seed="${DEMO_SEED:-0}"
 num_map_images="${DEMO_MAP_IMAGES:-60}"
 num_framesets="${DEMO_FRAMESETS:-20}"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
-rig_calibrator="$build/rig_calibrator"
-
-die() { echo "[demo] ERROR: $*" >&2; exit 1; }
-
 # A folder this demo wrote before (it holds the marker file) is replaced; any
 # other non-empty folder is left alone.
 marker=".rig_calibrator_demo"
@@ -48,17 +45,6 @@ out="$(mkdir -p "$out" && cd "$out" && pwd)"
 touch "$out/$marker"
 
 demo_start=$SECONDS
-timings=()
-# Runs a step and records its wall time.
-run_step() {
-  local name="$1"
-  shift
-  local start=$SECONDS
-  echo
-  echo "[demo] === $name"
-  "$@" || die "step '$name' failed"
-  timings+=("$(printf '%-40s %5d s' "$name" $((SECONDS - start)))")
-}
 
 if [[ "${DEMO_SKIP_BUILD:-0}" != 1 ]]; then
   run_step "build" bash "$repo/scripts/build.sh"
@@ -97,10 +83,7 @@ mkdir -p "$out/all_images"
 ln -s "$dataset"/map_images/* "$out/all_images/"
 ln -s "$dataset"/rig_images/* "$out/all_images/"
 
-echo
-echo "[demo] === timings"
-printf '  %s\n' "${timings[@]}"
-printf '  %-40s %5d s\n' "total" $((SECONDS - demo_start))
+print_timings "$demo_start"
 cat << INFO
 
 [demo] outputs in $out:

@@ -6,14 +6,14 @@
 # PRESET: ring5 (default), fisheye_helmet5, car_surround4, stereo_pair.
 set -euo pipefail
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+log_tag=demo_synthetic
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 out="${1:-$repo/demo_output/synthetic}"
 preset="${2:-ring5}"
 
 bash "$repo/scripts/build.sh"
 mkdir -p "$out"
-rig_calibrator="$build/rig_calibrator"
 
 echo "== Synthetic dataset ($preset) in $out/data"
 log="$(mktemp)"

@@ -36,21 +36,19 @@
 #   scripts/calibrate_rig.sh
 set -euo pipefail
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+log_tag=euroc
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 out="${1:-$repo/demo_output/euroc}"
 data="${EUROC_DIR:-/work/shared/data/euroc_v1_01_micro}"
 map_every="${EUROC_MAP_EVERY:-8}"
 map_model="${EUROC_MAP_MODEL:-RADIAL}"
 diagnostic="${EUROC_DIAGNOSTIC:-1}"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
-rig_calibrator="$build/rig_calibrator"
 tools="$repo/scripts/euroc_tools.py"
 marker=".euroc_check_output"
 
-die() { echo "[euroc] ERROR: $*" >&2; exit 1; }
-
 if [[ $# -gt 1 || "${1:-}" == "-h" || "${1:-}" == "--help" ]]; then
-  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//' >&2
+  usage >&2
   exit 2
 fi
 [[ "$map_every" =~ ^[1-9][0-9]*$ ]] || die "EUROC_MAP_EVERY must be a positive integer, got '$map_every'"
@@ -74,29 +72,11 @@ mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 touch "$out/$marker"
 
-default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
-if [[ -n "${COLMAP:-}" ]]; then
-  colmap="$COLMAP"
-elif [[ -x "$default_colmap" ]]; then
-  colmap="$default_colmap"
-elif command -v colmap > /dev/null; then
-  colmap="$(command -v colmap)"
-else
-  die "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
-fi
+# shellcheck source=find_colmap.sh
+source "$repo/scripts/find_colmap.sh"
 
 total_start=$SECONDS
-timings=()
-# Runs a step and records its wall time.
-run_step() {
-  local name="$1"
-  shift
-  local start=$SECONDS
-  echo
-  echo "[euroc] === $name"
-  "$@" || die "step '$name' failed"
-  timings+=("$(printf '%-52s %5d s' "$name" $((SECONDS - start)))")
-}
+step_name_width=52
 # Runs one colmap command, its output appended to $log.
 colmap_logged() {
   local log="$1"
@@ -294,9 +274,7 @@ if [[ "$diagnostic" == 1 ]]; then
 fi
 
 echo
-echo "[euroc] === timings"
-printf '  %s\n' "${timings[@]}"
-printf '  %-52s %5d s\n' "total" $((SECONDS - total_start))
+print_timings "$total_start"
 cat << INFO
 
 [euroc] outputs in $out:

@@ -2,8 +2,9 @@
 # The test command: sets up dependencies, builds, and runs the whole suite with ctest.
 set -euo pipefail
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+log_tag=run_tests
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 bash "$repo/scripts/build.sh"

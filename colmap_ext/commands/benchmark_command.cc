@@ -9,13 +9,12 @@
 #include <glog/logging.h>
 
 #include <boost/filesystem.hpp>
-#include <boost/program_options.hpp>
 #include <iomanip>
 #include <iostream>
 
-#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/atomic_output.h"
 #include "src/experiments/accuracy_experiment.h"
 #include "src/experiments/robustness_experiment.h"
 #include "src/experiments/short_sequence_experiment.h"
@@ -31,6 +30,25 @@ struct DataOverrides {
   double noise_px = -1, outlier_ratio = -1, missing_image_ratio = -1;
   double feature_window = -1;
   int frameset_stride = -1;
+
+  // The options that set them, prefixed "short_sequence: " in the help.
+  void AddOptions(boost::program_options::options_description* description) {
+    const std::string only = "short_sequence: ";
+    AddUnsetOption(description, "points_per_image", &points_per_image,
+                   only + "correspondences per image");
+    AddUnsetOption(description, "noise_px", &noise_px,
+                   only + "pixel noise (standard deviation)");
+    AddUnsetOption(description, "outlier_ratio", &outlier_ratio,
+                   only + "share of wrong 2D-3D matches");
+    AddUnsetOption(description, "missing_image_ratio", &missing_image_ratio,
+                   only + "share of images dropped");
+    AddUnsetOption(description, "feature_window", &feature_window,
+                   only +
+                       "side of the per-image feature window (share of "
+                       "the image)");
+    AddUnsetOption(description, "frameset_stride", &frameset_stride,
+                   only + "recording framesets between sequence ones");
+  }
 
   void Apply(BenchmarkDifficulty* difficulty) const {
     if (points_per_image >= 0) difficulty->points_per_image = points_per_image;
@@ -49,7 +67,7 @@ bool WriteResult(const std::string& folder, const std::string& name,
   std::string error;
   const std::string path = (boost::filesystem::path(folder) / name).string();
   if (!WriteFileAtomically(path, contents, &error)) {
-    std::cerr << "ERROR: " << error << std::endl;
+    PrintError(error);
     return false;
   }
   std::cout << "  wrote " << path << std::endl;
@@ -145,8 +163,7 @@ bool RunRobustness(const RobustnessOptions& options,
   boost::system::error_code error_code;
   boost::filesystem::create_directories(plots, error_code);
   if (error_code) {
-    std::cerr << "ERROR: cannot create " << plots << ": "
-              << error_code.message() << std::endl;
+    PrintError("cannot create " + plots + ": " + error_code.message());
     return false;
   }
   for (const RobustnessCell& cell : cells) {
@@ -167,9 +184,7 @@ bool RunRobustness(const RobustnessOptions& options,
          WriteResult(folder, "robustness_good.svg", GoodCalibrationsSvg(cells));
 }
 
-}  // namespace
-
-int RunBenchmark(int argc, char** argv) {
+struct BenchmarkCommandOptions {
   std::string experiment = "short_sequence";
   std::string preset = "ring5";
   std::string scene_name = "indoor";
@@ -183,143 +198,140 @@ int RunBenchmark(int argc, char** argv) {
   int recording_framesets = 120;
   int accuracy_framesets = 60;
   DataOverrides overrides;
-  namespace po = boost::program_options;
-  po::options_description description("rig_calibrator benchmark options");
-  description.add_options()("help,h", "show this help")(
-      "experiment", po::value(&experiment)->default_value(experiment),
-      "short_sequence (one robustness table), accuracy, robustness or all")(
-      "output_path", po::value(&output_path),
-      "short_sequence: also write the table (Markdown) to this file; "
-      "accuracy/robustness/all: the results folder (required)")(
-      "quick", po::value(&quick)->default_value(quick),
-      "1: a fast smoke run (fewer framesets, sequences, scenes)")(
-      "preset", po::value(&preset)->default_value(preset),
-      "short_sequence: ring5, fisheye_helmet5, car_surround4 or stereo_pair")(
-      "scene", po::value(&scene_name)->default_value(scene_name),
-      "short_sequence: indoor or outdoor")(
-      "difficulty", po::value(&difficulty_name)->default_value(difficulty_name),
-      "short_sequence: easy or hard (the data below override it)")(
-      "num_sequences", po::value(&num_sequences)->default_value(num_sequences),
-      "short sequences per cell (paper §5.3)")(
-      "framesets_per_sequence",
-      po::value(&framesets_per_sequence)->default_value(framesets_per_sequence),
-      "framesets per sequence")(
-      "recording_framesets",
-      po::value(&recording_framesets)->default_value(recording_framesets),
-      "framesets of the recording the sequences are cut from")(
-      "accuracy_framesets",
-      po::value(&accuracy_framesets)->default_value(accuracy_framesets),
-      "framesets of each accuracy recording")(
-      "points_per_image", po::value(&overrides.points_per_image),
-      "short_sequence: correspondences per image")(
-      "noise_px", po::value(&overrides.noise_px),
-      "short_sequence: pixel noise (standard deviation)")(
-      "outlier_ratio", po::value(&overrides.outlier_ratio),
-      "short_sequence: share of wrong 2D-3D matches")(
-      "missing_image_ratio", po::value(&overrides.missing_image_ratio),
-      "short_sequence: share of images dropped")(
-      "feature_window", po::value(&overrides.feature_window),
-      "short_sequence: side of the per-image feature window (share of the "
-      "image)")("frameset_stride", po::value(&overrides.frameset_stride),
-                "short_sequence: recording framesets between sequence ones")(
-      "num_threads", po::value(&num_threads)->default_value(num_threads),
-      "calibrations run in parallel (-1: all cores)")(
-      "seed", po::value(&seed)->default_value(seed), "random seed");
-  int exit_code = EXIT_SUCCESS;
-  if (!ParseCommandLine(argc, argv, description,
-                        "rig_calibrator benchmark: the paper's accuracy "
-                        "(§5.2) and robustness (§5.3, §5.4) experiments on "
-                        "synthetic rigs",
-                        &exit_code)) {
-    return exit_code;
-  }
-  // Hundreds of calibrations: keep their per-stage log lines off the tables.
-  FLAGS_minloglevel = google::GLOG_WARNING;
+};
 
-  if (experiment == "short_sequence") {
-    ShortSequenceOptions options;
-    BenchmarkScene scene;
-    BenchmarkDifficulty difficulty;
-    if (!RigPresetFromName(preset, &options.recording.preset) ||
-        !BenchmarkSceneFromName(scene_name, &scene) ||
-        !BenchmarkDifficultyFromName(difficulty_name, &difficulty)) {
-      std::cerr << "ERROR: unknown preset, scene or difficulty: " << preset
-                << ", " << scene_name << ", " << difficulty_name << std::endl;
-      return EXIT_FAILURE;
-    }
-    overrides.Apply(&difficulty);
-    ApplyScene(scene, &options.recording);
-    ApplyDifficulty(difficulty, &options);
-    options.recording.num_framesets = recording_framesets;
-    options.recording.seed = static_cast<unsigned int>(seed);
-    options.num_sequences = num_sequences;
-    options.framesets_per_sequence = framesets_per_sequence;
-    options.good_center_error = scene.good_center_error;
-    options.seed = static_cast<unsigned int>(seed);
-    options.num_threads = num_threads;
-    std::string error;
-    if (!options.recording.Check(&error)) {
-      std::cerr << "ERROR: " << error << std::endl;
-      return EXIT_FAILURE;
-    }
-    std::cout << "Short-sequence robustness, " << preset << " / " << scene.name
-              << ": " << options.num_sequences << " sequences of "
-              << options.framesets_per_sequence << " framesets; "
-              << options.recording.points_per_image
-              << " correspondences per image, window "
-              << options.recording.feature_window << ", noise "
-              << options.recording.noise_px << " px, outliers "
-              << options.recording.outlier_ratio << ", missing "
-              << options.recording.missing_image_ratio << ", stride "
-              << options.frameset_stride << std::endl;
-    const std::string table =
-        FormatShortSequenceResults(RunShortSequenceExperiment(options));
-    std::cout << table << std::flush;
-    if (!output_path.empty() &&
-        !WriteFileAtomically(output_path, table, &error)) {
-      std::cerr << "ERROR: " << error << std::endl;
-      return EXIT_FAILURE;
-    }
-    return EXIT_SUCCESS;
-  }
+boost::program_options::options_description Describe(
+    BenchmarkCommandOptions* o) {
+  boost::program_options::options_description description =
+      CommandOptions("rig_calibrator benchmark options");
+  AddOption(&description, "experiment", &o->experiment,
+            "short_sequence (one robustness table), accuracy, robustness or "
+            "all");
+  AddUnsetOption(&description, "output_path", &o->output_path,
+                 "short_sequence: also write the table (Markdown) to this "
+                 "file; accuracy/robustness/all: the results folder "
+                 "(required)");
+  AddOption(&description, "quick", &o->quick,
+            "1: a fast smoke run (fewer framesets, sequences, scenes)");
+  AddOption(&description, "preset", &o->preset,
+            "short_sequence: ring5, fisheye_helmet5, car_surround4 or "
+            "stereo_pair");
+  AddOption(&description, "scene", &o->scene_name,
+            "short_sequence: indoor or outdoor");
+  AddOption(&description, "difficulty", &o->difficulty_name,
+            "short_sequence: easy or hard (the data below override it)");
+  AddOption(&description, "num_sequences", &o->num_sequences,
+            "short sequences per cell (paper §5.3)");
+  AddOption(&description, "framesets_per_sequence", &o->framesets_per_sequence,
+            "framesets per sequence");
+  AddOption(&description, "recording_framesets", &o->recording_framesets,
+            "framesets of the recording the sequences are cut from");
+  AddOption(&description, "accuracy_framesets", &o->accuracy_framesets,
+            "framesets of each accuracy recording");
+  o->overrides.AddOptions(&description);
+  AddOption(&description, "num_threads", &o->num_threads,
+            "calibrations run in parallel (-1: all cores)");
+  AddOption(&description, "seed", &o->seed, "random seed");
+  return description;
+}
 
+int RunShortSequence(const BenchmarkCommandOptions& command) {
+  ShortSequenceOptions options;
+  BenchmarkScene scene;
+  BenchmarkDifficulty difficulty;
+  if (!RigPresetFromName(command.preset, &options.recording.preset) ||
+      !BenchmarkSceneFromName(command.scene_name, &scene) ||
+      !BenchmarkDifficultyFromName(command.difficulty_name, &difficulty)) {
+    return PrintError("unknown preset, scene or difficulty: " + command.preset +
+                      ", " + command.scene_name + ", " +
+                      command.difficulty_name);
+  }
+  command.overrides.Apply(&difficulty);
+  ApplyScene(scene, &options.recording);
+  ApplyDifficulty(difficulty, &options);
+  options.recording.num_framesets = command.recording_framesets;
+  options.recording.seed = static_cast<unsigned int>(command.seed);
+  options.num_sequences = command.num_sequences;
+  options.framesets_per_sequence = command.framesets_per_sequence;
+  options.good_center_error = scene.good_center_error;
+  options.seed = static_cast<unsigned int>(command.seed);
+  options.num_threads = command.num_threads;
+  std::string error;
+  if (!options.recording.Check(&error)) return PrintError(error);
+  std::cout << "Short-sequence robustness, " << command.preset << " / "
+            << scene.name << ": " << options.num_sequences << " sequences of "
+            << options.framesets_per_sequence << " framesets; "
+            << options.recording.points_per_image
+            << " correspondences per image, window "
+            << options.recording.feature_window << ", noise "
+            << options.recording.noise_px << " px, outliers "
+            << options.recording.outlier_ratio << ", missing "
+            << options.recording.missing_image_ratio << ", stride "
+            << options.frameset_stride << std::endl;
+  const std::string table =
+      FormatShortSequenceResults(RunShortSequenceExperiment(options));
+  std::cout << table << std::flush;
+  if (!command.output_path.empty() &&
+      !WriteFileAtomically(command.output_path, table, &error)) {
+    return PrintError(error);
+  }
+  return EXIT_SUCCESS;
+}
+
+// --experiment accuracy, robustness or all.
+int RunExperiments(const BenchmarkCommandOptions& command) {
+  const std::string& experiment = command.experiment;
   const bool run_accuracy = experiment == "accuracy" || experiment == "all";
   const bool run_robustness = experiment == "robustness" || experiment == "all";
   if (!run_accuracy && !run_robustness) {
-    std::cerr << "ERROR: unknown experiment " << experiment
-              << " (short_sequence, accuracy, robustness or all)" << std::endl;
-    return EXIT_FAILURE;
+    return PrintError("unknown experiment " + experiment +
+                      " (short_sequence, accuracy, robustness or all)");
   }
-  if (output_path.empty()) {
-    std::cerr << "ERROR: --experiment " << experiment
-              << " needs --output_path (the results folder)" << std::endl;
-    return EXIT_FAILURE;
+  if (command.output_path.empty()) {
+    return PrintError("--experiment " + experiment +
+                      " needs --output_path (the results folder)");
   }
   boost::system::error_code error_code;
-  boost::filesystem::create_directories(output_path, error_code);
+  boost::filesystem::create_directories(command.output_path, error_code);
   if (error_code) {
-    std::cerr << "ERROR: cannot create the results folder " << output_path
-              << ": " << error_code.message() << std::endl;
-    return EXIT_FAILURE;
+    return PrintError("cannot create the results folder " +
+                      command.output_path + ": " + error_code.message());
   }
   if (run_accuracy) {
     AccuracyOptions options;
-    options.num_framesets = quick ? 15 : accuracy_framesets;
-    if (quick) options.scenes.resize(1);
-    options.seed = static_cast<unsigned int>(seed);
-    options.num_threads = num_threads;
-    if (!RunAccuracy(options, output_path)) return EXIT_FAILURE;
+    options.num_framesets = command.quick ? 15 : command.accuracy_framesets;
+    if (command.quick) options.scenes.resize(1);
+    options.seed = static_cast<unsigned int>(command.seed);
+    options.num_threads = command.num_threads;
+    if (!RunAccuracy(options, command.output_path)) return EXIT_FAILURE;
   }
   if (run_robustness) {
     RobustnessOptions options;
-    options.num_sequences = quick ? 6 : num_sequences;
-    options.framesets_per_sequence = framesets_per_sequence;
-    options.recording_framesets = quick ? 40 : recording_framesets;
-    options.seed = static_cast<unsigned int>(seed);
-    options.num_threads = num_threads;
-    if (!RunRobustness(options, output_path)) return EXIT_FAILURE;
+    options.num_sequences = command.quick ? 6 : command.num_sequences;
+    options.framesets_per_sequence = command.framesets_per_sequence;
+    options.recording_framesets =
+        command.quick ? 40 : command.recording_framesets;
+    options.seed = static_cast<unsigned int>(command.seed);
+    options.num_threads = command.num_threads;
+    if (!RunRobustness(options, command.output_path)) return EXIT_FAILURE;
   }
   return EXIT_SUCCESS;
+}
+
+}  // namespace
+
+int RunBenchmark(int argc, char** argv) {
+  BenchmarkCommandOptions options;
+  if (const std::optional<int> exit_code = ParseCommandLine(
+          argc, argv, Describe(&options),
+          "rig_calibrator benchmark: the paper's accuracy (§5.2) and "
+          "robustness (§5.3, §5.4) experiments on synthetic rigs")) {
+    return *exit_code;
+  }
+  // Hundreds of calibrations: keep their per-stage log lines off the tables.
+  FLAGS_minloglevel = google::GLOG_WARNING;
+  return options.experiment == "short_sequence" ? RunShortSequence(options)
+                                                : RunExperiments(options);
 }
 
 }  // namespace rig_calibrator

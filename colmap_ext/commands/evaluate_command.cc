@@ -2,9 +2,9 @@
 #include <boost/program_options.hpp>
 #include <iostream>
 
-#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/rig_reference_io.h"
 #include "src/evaluation/evaluation.h"
 
@@ -80,34 +80,32 @@ bool MatchCameras(const RigDescription& reference,
 
 int RunEvaluate(int argc, char** argv) {
   EvaluateOptions options;
-  po::options_description description("rig_calibrator evaluate options");
-  description.add_options()("help,h", "show this help")(
-      "reference_path", po::value(&options.reference_path)->required(),
-      "reference calibration: rig_calibrator output folder, rig_config.json "
-      "or camchain.yaml")("calibration_path",
-                          po::value(&options.calibration_path)->required(),
-                          "calibration to evaluate, in the same formats")(
-      "output_path", po::value(&options.output_path),
-      "write the errors as JSON to this file")(
-      "align_scale", po::value(&options.align_scale)->default_value(false),
-      "also align the scale (for calibrations against non-metric maps)")(
-      "align_reference_camera",
-      po::value(&options.align_reference_camera)->default_value(false),
-      "align the rigs by their reference cameras instead of all cameras");
-  int exit_code = EXIT_SUCCESS;
-  if (!ParseCommandLine(argc, argv, description,
-                        "rig_calibrator evaluate: compare a calibration with a "
-                        "reference calibration",
-                        &exit_code)) {
-    return exit_code;
+  po::options_description description =
+      CommandOptions("rig_calibrator evaluate options");
+  AddRequiredOption(&description, "reference_path", &options.reference_path,
+                    "reference calibration: rig_calibrator output folder, "
+                    "rig_config.json or camchain.yaml");
+  AddRequiredOption(&description, "calibration_path", &options.calibration_path,
+                    "calibration to evaluate, in the same formats");
+  AddUnsetOption(&description, "output_path", &options.output_path,
+                 "write the errors as JSON to this file");
+  AddOption(&description, "align_scale", &options.align_scale,
+            "also align the scale (for calibrations against non-metric maps)");
+  AddOption(&description, "align_reference_camera",
+            &options.align_reference_camera,
+            "align the rigs by their reference cameras instead of all cameras");
+  if (const std::optional<int> exit_code = ParseCommandLine(
+          argc, argv, description,
+          "rig_calibrator evaluate: compare a calibration with a reference "
+          "calibration")) {
+    return *exit_code;
   }
 
   std::string error;
   RigDescription reference, estimate;
   if (!ReadRigReference(options.reference_path, &reference, &error) ||
       !ReadRigReference(options.calibration_path, &estimate, &error)) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   std::vector<colmap::Camera> reference_cameras, estimated_cameras;
   std::vector<Rigid3d> reference_cam_from_rig, estimated_cam_from_rig;
@@ -115,8 +113,7 @@ int RunEvaluate(int argc, char** argv) {
   if (!MatchCameras(reference, estimate, &reference_cameras,
                     &reference_cam_from_rig, &estimated_cameras,
                     &estimated_cam_from_rig, &names, &error)) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   CompareOptions compare;
   compare.align_scale = options.align_scale;
@@ -127,8 +124,7 @@ int RunEvaluate(int argc, char** argv) {
       CompareCalibrations(reference_cameras, reference_cam_from_rig,
                           estimated_cameras, estimated_cam_from_rig, compare);
   if (!errors.ok()) {
-    std::cerr << "ERROR: " << errors.error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(errors.error);
   }
   std::cout << "Calibration " << options.calibration_path << "\nagainst "
             << options.reference_path << "\n\n"
@@ -137,8 +133,7 @@ int RunEvaluate(int argc, char** argv) {
       !WriteFileAtomically(options.output_path,
                            CalibrationErrorToJson(errors, names).dump(2) + "\n",
                            &error)) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   return EXIT_SUCCESS;
 }

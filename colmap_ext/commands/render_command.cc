@@ -8,8 +8,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/commands/command_options.h"
+#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/number_text.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
@@ -262,83 +262,58 @@ int RunRender(int argc, char** argv) {
   std::string scene_name = "room";
   std::string output_path;
   bool overwrite = false;
-  po::options_description description("rig_calibrator render options");
-  description.add_options()("help,h", "show this help")(
-      "output_path", po::value<std::string>(&output_path)->required(),
-      "folder to write (map_images/, rig_images/, ground_truth/)")(
-      "preset",
-      po::value<std::string>(&preset_name)->default_value(preset_name),
-      "rig: ring5, fisheye_helmet5, car_surround4, stereo_pair")(
-      "scene", po::value<std::string>(&scene_name)->default_value(scene_name),
-      "scene: room, courtyard, street")(
-      "num_map_images",
-      po::value<int>(&dataset_options.num_map_images)
-          ->default_value(dataset_options.num_map_images),
-      "images of the mapping sequence")(
-      "num_framesets",
-      po::value<int>(&dataset_options.num_framesets)
-          ->default_value(dataset_options.num_framesets),
-      "framesets of the rig sequence")(
-      "seed",
-      po::value<unsigned int>(&dataset_options.seed)
-          ->default_value(dataset_options.seed),
-      "seed of the textures, trajectories and noise")(
-      "map_width",
-      po::value<int>(&dataset_options.map_width)
-          ->default_value(dataset_options.map_width),
-      "map camera image width")("map_height",
-                                po::value<int>(&dataset_options.map_height)
-                                    ->default_value(dataset_options.map_height),
-                                "map camera image height")(
-      "map_focal_length",
-      po::value<double>(&dataset_options.map_focal_length)
-          ->default_value(dataset_options.map_focal_length),
-      "map camera focal length in pixels (PINHOLE)")(
-      "rig_height",
-      po::value<double>(&dataset_options.rig_height)
-          ->default_value(dataset_options.rig_height),
-      "height of the rig above the ground in meters (0: the scene's)")(
-      "supersampling",
-      po::value<int>(&render_options.supersampling)
-          ->default_value(render_options.supersampling),
-      "samples per pixel along each axis at silhouettes and face boundaries")(
-      "noise_stddev",
-      po::value<double>(&render_options.noise_stddev)
-          ->default_value(render_options.noise_stddev),
-      "Gaussian pixel noise in grey levels")(
-      "rgb",
-      po::value<bool>(&render_options.as_rgb)
-          ->default_value(render_options.as_rgb),
-      "1: RGB images, 0: grey")(
-      "overwrite", po::value<bool>(&overwrite)->default_value(overwrite),
-      "replace a non-empty output folder");
-  int exit_code = EXIT_SUCCESS;
-  if (!ParseCommandLine(argc, argv, description,
-                        "rig_calibrator render: renders a rig dataset with "
-                        "exact ground truth (a mapping sequence and a rig "
-                        "calibration sequence)",
-                        &exit_code)) {
-    return exit_code;
+  po::options_description description =
+      CommandOptions("rig_calibrator render options");
+  AddRequiredOption(
+      &description, "output_path", &output_path,
+      "folder to write (map_images/, rig_images/, ground_truth/)");
+  AddOption(&description, "preset", &preset_name,
+            "rig: ring5, fisheye_helmet5, car_surround4, stereo_pair");
+  AddOption(&description, "scene", &scene_name,
+            "scene: room, courtyard, street");
+  AddOption(&description, "num_map_images", &dataset_options.num_map_images,
+            "images of the mapping sequence");
+  AddOption(&description, "num_framesets", &dataset_options.num_framesets,
+            "framesets of the rig sequence");
+  AddOption(&description, "seed", &dataset_options.seed,
+            "seed of the textures, trajectories and noise");
+  AddOption(&description, "map_width", &dataset_options.map_width,
+            "map camera image width");
+  AddOption(&description, "map_height", &dataset_options.map_height,
+            "map camera image height");
+  AddOption(&description, "map_focal_length", &dataset_options.map_focal_length,
+            "map camera focal length in pixels (PINHOLE)");
+  AddOption(&description, "rig_height", &dataset_options.rig_height,
+            "height of the rig above the ground in meters (0: the scene's)");
+  AddOption(&description, "supersampling", &render_options.supersampling,
+            "samples per pixel along each axis at silhouettes and face "
+            "boundaries");
+  AddOption(&description, "noise_stddev", &render_options.noise_stddev,
+            "Gaussian pixel noise in grey levels");
+  AddOption(&description, "rgb", &render_options.as_rgb,
+            "1: RGB images, 0: grey");
+  AddOverwriteOption(&description, &overwrite);
+  if (const std::optional<int> exit_code = ParseCommandLine(
+          argc, argv, description,
+          "rig_calibrator render: renders a rig dataset with exact ground "
+          "truth (a mapping sequence and a rig calibration sequence)")) {
+    return *exit_code;
   }
   if (!RigPresetFromName(preset_name, &dataset_options.preset)) {
-    std::cerr << "ERROR: unknown --preset " << preset_name
-              << "; choose ring5, fisheye_helmet5, car_surround4 or "
-                 "stereo_pair"
-              << std::endl;
-    return EXIT_FAILURE;
+    return PrintError("unknown --preset " + preset_name +
+                      "; choose ring5, fisheye_helmet5, car_surround4 or "
+                      "stereo_pair");
   }
   if (!SceneTypeFromName(scene_name, &dataset_options.scene)) {
-    std::cerr << "ERROR: unknown --scene " << scene_name
-              << "; choose room, courtyard or street" << std::endl;
-    return EXIT_FAILURE;
+    return PrintError("unknown --scene " + scene_name +
+                      "; choose room, courtyard or street");
   }
   std::string error;
   RenderedDatasetPlan plan;
   if (!PlanRenderedDataset(dataset_options, &plan, &error) ||
       !WriteRenderedDataset(dataset_options, plan, render_options, output_path,
                             overwrite, &error)) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   std::cout << "Wrote " << output_path << ": map_images/ ("
             << plan.map_image_names.size() << "), rig_images/ ("

@@ -2,13 +2,12 @@
 // correspondences) and its exact ground truth, to try the calibration or to
 // feed benchmarks without images.
 #include <boost/filesystem.hpp>
-#include <boost/program_options.hpp>
 #include <iostream>
 
-#include "colmap_ext/io/atomic_output.h"
-#include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
@@ -38,55 +37,35 @@ int RunSynthetic(int argc, char** argv) {
   std::string output_path;
   bool overwrite = false;
   int seed = 0;
-  namespace po = boost::program_options;
-  po::options_description description("rig_calibrator synthetic options");
-  description.add_options()("help,h", "show this help")(
-      "output_path", po::value(&output_path)->required(),
-      "output folder: correspondences.txt and ground_truth/")(
-      "preset", po::value(&preset)->default_value(preset),
-      "ring5, fisheye_helmet5, car_surround4 or stereo_pair")(
-      "num_framesets",
-      po::value(&options.num_framesets)->default_value(options.num_framesets),
-      "framesets")("points_per_image",
-                   po::value(&options.points_per_image)
-                       ->default_value(options.points_per_image),
-                   "correspondences per image")(
-      "noise_px", po::value(&options.noise_px)->default_value(options.noise_px),
-      "pixel noise (standard deviation)")(
-      "outlier_ratio",
-      po::value(&options.outlier_ratio)->default_value(options.outlier_ratio),
-      "share of wrong 2D-3D matches")(
-      "missing_image_ratio",
-      po::value(&options.missing_image_ratio)
-          ->default_value(options.missing_image_ratio),
-      "share of images dropped")(
-      "min_depth",
-      po::value(&options.min_depth)->default_value(options.min_depth),
-      "nearest map points (map units)")(
-      "max_depth",
-      po::value(&options.max_depth)->default_value(options.max_depth),
-      "farthest map points (map units)")(
-      "seed", po::value(&seed)->default_value(seed), "random seed")(
-      "overwrite", po::value(&overwrite)->default_value(false),
-      "replace a non-empty output folder");
-  int exit_code = EXIT_SUCCESS;
-  if (!ParseCommandLine(argc, argv, description,
-                        "rig_calibrator synthetic: write a synthetic rig "
-                        "dataset with exact ground truth",
-                        &exit_code)) {
-    return exit_code;
+  boost::program_options::options_description description =
+      CommandOptions("rig_calibrator synthetic options");
+  AddRequiredOption(&description, "output_path", &output_path,
+                    "output folder: correspondences.txt and ground_truth/");
+  AddOption(&description, "preset", &preset,
+            "ring5, fisheye_helmet5, car_surround4 or stereo_pair");
+  AddOption(&description, "num_framesets", &options.num_framesets, "framesets");
+  AddSyntheticDataOptions(&description, &options);
+  AddOption(&description, "min_depth", &options.min_depth,
+            "nearest map points (map units)");
+  AddOption(&description, "max_depth", &options.max_depth,
+            "farthest map points (map units)");
+  AddOption(&description, "seed", &seed, "random seed");
+  AddOverwriteOption(&description, &overwrite);
+  if (const std::optional<int> exit_code = ParseCommandLine(
+          argc, argv, description,
+          "rig_calibrator synthetic: write a synthetic rig dataset with exact "
+          "ground truth")) {
+    return *exit_code;
   }
   if (!RigPresetFromName(preset, &options.preset)) {
-    std::cerr << "ERROR: unknown preset " << preset
-              << "; use ring5, fisheye_helmet5, car_surround4 or stereo_pair"
-              << std::endl;
-    return EXIT_FAILURE;
+    return PrintError("unknown preset " + preset +
+                      "; use ring5, fisheye_helmet5, car_surround4 or "
+                      "stereo_pair");
   }
   options.seed = static_cast<unsigned int>(seed);
   std::string error;
   if (!options.Check(&error)) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   const SyntheticRig rig = GenerateSyntheticRig(options);
   const RigDescription truth = DescribeGroundTruth(rig.truth);
@@ -108,8 +87,7 @@ int RunSynthetic(int argc, char** argv) {
       },
       &error);
   if (!written) {
-    std::cerr << "ERROR: " << error << std::endl;
-    return EXIT_FAILURE;
+    return PrintError(error);
   }
   std::string models;
   for (size_t c = 0; c < rig.truth.cameras.size(); ++c) {

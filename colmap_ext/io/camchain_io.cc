@@ -151,6 +151,33 @@ bool ReadDoubles(const YAML::Node& node, size_t size,
   return true;
 }
 
+// How a COLMAP camera model's distortion maps to Kalibr's: the COLMAP
+// parameter index of every Kalibr coefficient (-1: 0), and the parameters
+// Kalibr's model has not, with which the mapping is exact only when they are
+// all 0 (else the coefficients are fitted, FitKalibrDistortion).
+struct DistortionMapping {
+  std::string model;
+  std::string kalibr_model;
+  std::vector<int> coeffs;
+  std::vector<int> not_in_kalibr;
+};
+
+const DistortionMapping kDistortionMappings[] = {
+    {"SIMPLE_PINHOLE", "radtan", {-1, -1, -1, -1}, {}},
+    {"PINHOLE", "radtan", {-1, -1, -1, -1}, {}},
+    {"SIMPLE_RADIAL", "radtan", {3, -1, -1, -1}, {}},
+    {"RADIAL", "radtan", {3, 4, -1, -1}, {}},
+    {"OPENCV", "radtan", {4, 5, 6, 7}, {}},
+    // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6.
+    {"FULL_OPENCV", "radtan", {4, 5, 6, 7}, {8, 9, 10, 11}},
+    {"OPENCV_FISHEYE", "equidistant", {4, 5, 6, 7}, {}},
+    {"SIMPLE_RADIAL_FISHEYE", "equidistant", {3, -1, -1, -1}, {}},
+    {"RADIAL_FISHEYE", "equidistant", {3, 4, -1, -1}, {}},
+    {"FOV", "fov", {4}, {}},
+    // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1.
+    {"THIN_PRISM_FISHEYE", "equidistant", {4, 5, 8, 9}, {6, 7, 10, 11}},
+};
+
 }  // namespace
 
 bool ColmapToKalibrCamera(const colmap::Camera& camera, KalibrCamera* kalibr,
@@ -171,43 +198,19 @@ bool ColmapToKalibrCamera(const colmap::Camera& camera, KalibrCamera* kalibr,
                         camera.PrincipalPointX() - kKalibrPixelShift,
                         camera.PrincipalPointY() - kKalibrPixelShift};
   const std::string model = camera.ModelName();
-  if (model == "SIMPLE_PINHOLE" || model == "PINHOLE") {
-    kalibr->distortion_model = "radtan";
-    kalibr->distortion_coeffs = {0, 0, 0, 0};
-  } else if (model == "SIMPLE_RADIAL") {
-    kalibr->distortion_model = "radtan";
-    kalibr->distortion_coeffs = {p[3], 0, 0, 0};
-  } else if (model == "RADIAL") {
-    kalibr->distortion_model = "radtan";
-    kalibr->distortion_coeffs = {p[3], p[4], 0, 0};
-  } else if (model == "OPENCV") {
-    kalibr->distortion_model = "radtan";
-    kalibr->distortion_coeffs = {p[4], p[5], p[6], p[7]};
-  } else if (model == "FULL_OPENCV") {
-    // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6.
-    kalibr->distortion_model = "radtan";
-    kalibr->distortion_coeffs = {p[4], p[5], p[6], p[7]};
-    kalibr->exact = p[8] == 0 && p[9] == 0 && p[10] == 0 && p[11] == 0;
-  } else if (model == "OPENCV_FISHEYE") {
-    kalibr->distortion_model = "equidistant";
-    kalibr->distortion_coeffs = {p[4], p[5], p[6], p[7]};
-  } else if (model == "SIMPLE_RADIAL_FISHEYE") {
-    kalibr->distortion_model = "equidistant";
-    kalibr->distortion_coeffs = {p[3], 0, 0, 0};
-  } else if (model == "RADIAL_FISHEYE") {
-    kalibr->distortion_model = "equidistant";
-    kalibr->distortion_coeffs = {p[3], p[4], 0, 0};
-  } else if (model == "FOV") {
-    kalibr->distortion_model = "fov";
-    kalibr->distortion_coeffs = {p[4]};
-  } else if (model == "THIN_PRISM_FISHEYE") {
-    // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1.
-    kalibr->distortion_model = "equidistant";
-    kalibr->distortion_coeffs = {p[4], p[5], p[8], p[9]};
-    kalibr->exact = p[6] == 0 && p[7] == 0 && p[10] == 0 && p[11] == 0;
-  } else {
+  const auto mapping = std::find_if(
+      std::begin(kDistortionMappings), std::end(kDistortionMappings),
+      [&](const DistortionMapping& m) { return m.model == model; });
+  if (mapping == std::end(kDistortionMappings)) {
     *error = "the camera model " + model + " has no Kalibr equivalent";
     return false;
+  }
+  kalibr->distortion_model = mapping->kalibr_model;
+  for (const int index : mapping->coeffs) {
+    kalibr->distortion_coeffs.push_back(index < 0 ? 0.0 : p[index]);
+  }
+  for (const int index : mapping->not_in_kalibr) {
+    kalibr->exact = kalibr->exact && p[index] == 0;
   }
   if (!kalibr->exact) {
     return FitKalibrDistortion(

@@ -65,6 +65,40 @@ class StatementScope {
   sqlite3_stmt* statement_;
 };
 
+// The (rows, cols, data) columns of the row a statement stepped to: COLMAP's
+// layout of keypoints, descriptors and matches.
+struct BlobMatrix {
+  int64_t rows = 0;
+  int64_t cols = 0;
+  int num_bytes = 0;
+  const void* data = nullptr;
+
+  static BlobMatrix OfRow(sqlite3_stmt* statement) {
+    return {
+        sqlite3_column_int64(statement, 0), sqlite3_column_int64(statement, 1),
+        sqlite3_column_bytes(statement, 2), sqlite3_column_blob(statement, 2)};
+  }
+  // "(rows x cols, num_bytes bytes)".
+  std::string ShapeText() const {
+    return "(" + std::to_string(rows) + "x" + std::to_string(cols) + ", " +
+           std::to_string(num_bytes) + " bytes)";
+  }
+};
+
+// Steps the keypoints or descriptors `statement` for `image_id`; false with
+// "<what> are missing" when the image has none.
+bool StepFeatureRow(sqlite3_stmt* statement, const colmap::image_t image_id,
+                    const std::string& what, BlobMatrix* blob,
+                    std::string* error) {
+  sqlite3_bind_int64(statement, 1, image_id);
+  if (sqlite3_step(statement) != SQLITE_ROW) {
+    *error = what + " are missing (run `colmap feature_extractor` on it)";
+    return false;
+  }
+  *blob = BlobMatrix::OfRow(statement);
+  return true;
+}
+
 }  // namespace
 
 DatabaseReader::DatabaseReader() = default;
@@ -366,25 +400,20 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
                                    std::string* error) const {
   std::lock_guard<std::mutex> lock(mutex_);
   StatementScope scope(read_keypoints_);
-  sqlite3_bind_int64(read_keypoints_, 1, image_id);
   const std::string what =
       "database " + path_ + ": keypoints of " + ImageLabel(image_id);
-  if (sqlite3_step(read_keypoints_) != SQLITE_ROW) {
-    *error = what + " are missing (run `colmap feature_extractor` on it)";
+  BlobMatrix blob;
+  if (!StepFeatureRow(read_keypoints_, image_id, what, &blob, error)) {
     return false;
   }
-  const int64_t rows = sqlite3_column_int64(read_keypoints_, 0);
-  const int64_t cols = sqlite3_column_int64(read_keypoints_, 1);
-  const int num_bytes = sqlite3_column_bytes(read_keypoints_, 2);
+  const int64_t rows = blob.rows;
+  const int64_t cols = blob.cols;
   if (rows < 0 || (rows > 0 && cols != 2 && cols != 4 && cols != 6) ||
-      num_bytes != rows * cols * static_cast<int64_t>(sizeof(float))) {
-    *error = what + " are malformed (" + std::to_string(rows) + "x" +
-             std::to_string(cols) + ", " + std::to_string(num_bytes) +
-             " bytes)";
+      blob.num_bytes != rows * cols * static_cast<int64_t>(sizeof(float))) {
+    *error = what + " are malformed " + blob.ShapeText();
     return false;
   }
-  const float* data =
-      static_cast<const float*>(sqlite3_column_blob(read_keypoints_, 2));
+  const float* data = static_cast<const float*>(blob.data);
   keypoints->resize(rows);
   for (int64_t i = 0; i < rows; ++i) {
     const float* row = data + i * cols;
@@ -405,31 +434,24 @@ bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
                                      std::string* error) const {
   std::lock_guard<std::mutex> lock(mutex_);
   StatementScope scope(read_descriptors_);
-  sqlite3_bind_int64(read_descriptors_, 1, image_id);
   const std::string what =
       "database " + path_ + ": descriptors of " + ImageLabel(image_id);
-  if (sqlite3_step(read_descriptors_) != SQLITE_ROW) {
-    *error = what + " are missing (run `colmap feature_extractor` on it)";
+  BlobMatrix blob;
+  if (!StepFeatureRow(read_descriptors_, image_id, what, &blob, error)) {
     return false;
   }
-  const int64_t rows = sqlite3_column_int64(read_descriptors_, 0);
-  const int64_t cols = sqlite3_column_int64(read_descriptors_, 1);
-  const int num_bytes = sqlite3_column_bytes(read_descriptors_, 2);
-  if (rows > 0 && cols != 128) {
-    *error = what + " have " + std::to_string(cols) +
+  if (blob.rows > 0 && blob.cols != 128) {
+    *error = what + " have " + std::to_string(blob.cols) +
              " dimensions; rig_calibrator matches 128-dimensional SIFT";
     return false;
   }
-  if (rows < 0 || num_bytes != rows * cols) {
-    *error = what + " are malformed (" + std::to_string(rows) + "x" +
-             std::to_string(cols) + ", " + std::to_string(num_bytes) +
-             " bytes)";
+  if (blob.rows < 0 || blob.num_bytes != blob.rows * blob.cols) {
+    *error = what + " are malformed " + blob.ShapeText();
     return false;
   }
-  descriptors->resize(rows, 128);
-  if (rows > 0) {
-    std::memcpy(descriptors->data(), sqlite3_column_blob(read_descriptors_, 2),
-                num_bytes);
+  descriptors->resize(blob.rows, 128);
+  if (blob.rows > 0) {
+    std::memcpy(descriptors->data(), blob.data, blob.num_bytes);
   }
   return true;
 }
@@ -445,19 +467,17 @@ bool DatabaseReader::ReadInlierMatches(const colmap::image_t image_id1,
       read_inlier_matches_, 1,
       static_cast<sqlite3_int64>(ImagePairToPairId(image_id1, image_id2)));
   if (sqlite3_step(read_inlier_matches_) != SQLITE_ROW) return true;
-  const int64_t rows = sqlite3_column_int64(read_inlier_matches_, 0);
-  const int64_t cols = sqlite3_column_int64(read_inlier_matches_, 1);
-  const int num_bytes = sqlite3_column_bytes(read_inlier_matches_, 2);
+  const BlobMatrix blob = BlobMatrix::OfRow(read_inlier_matches_);
+  const int64_t rows = blob.rows;
   if (rows <= 0) return true;
-  if (cols != 2 ||
-      num_bytes != rows * cols * static_cast<int64_t>(sizeof(uint32_t))) {
+  if (blob.cols != 2 ||
+      blob.num_bytes != rows * 2 * static_cast<int64_t>(sizeof(uint32_t))) {
     *error = "database " + path_ + ": inlier matches of " +
              ImageLabel(image_id1) + " and " + ImageLabel(image_id2) +
              " are malformed";
     return false;
   }
-  const uint32_t* data = static_cast<const uint32_t*>(
-      sqlite3_column_blob(read_inlier_matches_, 2));
+  const uint32_t* data = static_cast<const uint32_t*>(blob.data);
   // COLMAP stores the columns in the order (smaller id, larger id).
   const bool swapped = image_id1 > image_id2;
   matches->resize(rows);

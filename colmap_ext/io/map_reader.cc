@@ -2,10 +2,12 @@
 
 #include <colmap/base/camera_models.h>
 
+#include <algorithm>
 #include <boost/algorithm/string.hpp>
 #include <boost/filesystem.hpp>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 
 namespace rig_calibrator {
 namespace {
@@ -84,65 +86,70 @@ class BinaryWalker {
   uint64_t position_ = 0;
 };
 
-// Record layouts of COLMAP 3.8's Reconstruction::Write*Binary.
-bool CheckCamerasBinary(const fs::path& file, std::string* error) {
+// A COLMAP binary file: a uint64 record count, the records, nothing after.
+bool CheckBinaryRecords(const fs::path& file, const char* count_what,
+                        const std::function<bool(BinaryWalker*)>& check_record,
+                        std::string* error) {
   BinaryWalker walker(file, error);
   uint64_t count = 0;
-  if (!walker.Read(&count, "the camera count")) return false;
+  if (!walker.Read(&count, count_what)) return false;
   for (uint64_t i = 0; i < count; ++i) {
-    uint32_t camera_id = 0;
-    int32_t model_id = 0;
-    if (!walker.Read(&camera_id, "a camera id") ||
-        !walker.Read(&model_id, "a camera model id")) {
-      return false;
-    }
-    if (!colmap::ExistsCameraModelWithId(model_id)) {
-      return walker.Fail("camera " + std::to_string(camera_id) +
-                         " has the model id " + std::to_string(model_id) +
-                         ", which COLMAP 3.8 does not know");
-    }
-    if (!walker.Skip(2, sizeof(uint64_t), "a camera size") ||
-        !walker.Skip(colmap::CameraModelNumParams(model_id), sizeof(double),
-                     "camera parameters")) {
-      return false;
-    }
+    if (!check_record(&walker)) return false;
   }
   return walker.CheckEnd();
+}
+
+// Record layouts of COLMAP 3.8's Reconstruction::Write*Binary.
+bool CheckCamerasBinary(const fs::path& file, std::string* error) {
+  return CheckBinaryRecords(
+      file, "the camera count",
+      [](BinaryWalker* walker) {
+        uint32_t camera_id = 0;
+        int32_t model_id = 0;
+        if (!walker->Read(&camera_id, "a camera id") ||
+            !walker->Read(&model_id, "a camera model id")) {
+          return false;
+        }
+        if (!colmap::ExistsCameraModelWithId(model_id)) {
+          return walker->Fail("camera " + std::to_string(camera_id) +
+                              " has the model id " + std::to_string(model_id) +
+                              ", which COLMAP 3.8 does not know");
+        }
+        return walker->Skip(2, sizeof(uint64_t), "a camera size") &&
+               walker->Skip(colmap::CameraModelNumParams(model_id),
+                            sizeof(double), "camera parameters");
+      },
+      error);
 }
 
 bool CheckImagesBinary(const fs::path& file, std::string* error) {
-  BinaryWalker walker(file, error);
-  uint64_t count = 0;
-  if (!walker.Read(&count, "the image count")) return false;
-  for (uint64_t i = 0; i < count; ++i) {
-    uint64_t num_points2D = 0;
-    // id, qvec, tvec, camera id, name, points2D (x, y, point3D id).
-    if (!walker.Skip(1, 4 + 7 * sizeof(double) + 4, "an image record") ||
-        !walker.SkipString("an image name") ||
-        !walker.Read(&num_points2D, "a points2D count") ||
-        !walker.Skip(num_points2D, 2 * sizeof(double) + sizeof(uint64_t),
-                     "an image's points2D")) {
-      return false;
-    }
-  }
-  return walker.CheckEnd();
+  return CheckBinaryRecords(
+      file, "the image count",
+      [](BinaryWalker* walker) {
+        uint64_t num_points2D = 0;
+        // id, qvec, tvec, camera id, name, points2D (x, y, point3D id).
+        return walker->Skip(1, 4 + 7 * sizeof(double) + 4, "an image record") &&
+               walker->SkipString("an image name") &&
+               walker->Read(&num_points2D, "a points2D count") &&
+               walker->Skip(num_points2D, 2 * sizeof(double) + sizeof(uint64_t),
+                            "an image's points2D");
+      },
+      error);
 }
 
 bool CheckPoints3DBinary(const fs::path& file, std::string* error) {
-  BinaryWalker walker(file, error);
-  uint64_t count = 0;
-  if (!walker.Read(&count, "the point count")) return false;
-  for (uint64_t i = 0; i < count; ++i) {
-    uint64_t track_length = 0;
-    // id, xyz, rgb, error, track (image id, point2D index).
-    if (!walker.Skip(1, 8 + 3 * sizeof(double) + 3 + sizeof(double),
-                     "a point record") ||
-        !walker.Read(&track_length, "a track length") ||
-        !walker.Skip(track_length, 2 * sizeof(uint32_t), "a point's track")) {
-      return false;
-    }
-  }
-  return walker.CheckEnd();
+  return CheckBinaryRecords(
+      file, "the point count",
+      [](BinaryWalker* walker) {
+        uint64_t track_length = 0;
+        // id, xyz, rgb, error, track (image id, point2D index).
+        return walker->Skip(1, 8 + 3 * sizeof(double) + 3 + sizeof(double),
+                            "a point record") &&
+               walker->Read(&track_length, "a track length") &&
+               walker->Skip(track_length, 2 * sizeof(uint32_t),
+                            "a point's track");
+      },
+      error);
 }
 
 // COLMAP 3.8's text reader aborts on an unknown model name or a wrong number
@@ -267,6 +274,22 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
     return false;
   }
   return true;
+}
+
+colmap::camera_t MaxCameraId(const colmap::Reconstruction& model) {
+  colmap::camera_t max_camera_id = 0;
+  for (const auto& [camera_id, camera] : model.Cameras()) {
+    max_camera_id = std::max(max_camera_id, camera_id);
+  }
+  return max_camera_id;
+}
+
+colmap::image_t MaxImageId(const colmap::Reconstruction& model) {
+  colmap::image_t max_image_id = 0;
+  for (const auto& [image_id, image] : model.Images()) {
+    max_image_id = std::max(max_image_id, image_id);
+  }
+  return max_image_id;
 }
 
 }  // namespace rig_calibrator

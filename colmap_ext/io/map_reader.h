@@ -19,4 +19,9 @@ namespace rig_calibrator {
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              std::string* error);
 
+// The largest camera and image ids of a model (0 when it has none): new
+// cameras, images, rigs and frames are numbered after them.
+colmap::camera_t MaxCameraId(const colmap::Reconstruction& model);
+colmap::image_t MaxImageId(const colmap::Reconstruction& model);
+
 }  // namespace rig_calibrator

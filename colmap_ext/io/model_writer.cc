@@ -11,6 +11,7 @@
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
+#include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
 
@@ -79,6 +80,58 @@ bool MoveRefinedPoints(const RigCalibration& calibration,
   return true;
 }
 
+// Adds the registered image `image_id` of `rig_image` at cam_from_world, its
+// points2D the correspondences' 2D points, and its inlier correspondences to
+// map points as observations of those points (one per point).
+void AddRigImage(const RigImage& rig_image, const std::vector<char>& inliers,
+                 const colmap::image_t image_id,
+                 const colmap::camera_t camera_id,
+                 const Rigid3d& cam_from_world, colmap::Reconstruction* model) {
+  colmap::Image image;
+  image.SetImageId(image_id);
+  image.SetName(rig_image.name);
+  image.SetCameraId(camera_id);
+  image.SetQvec(cam_from_world.Qvec());
+  image.SetTvec(cam_from_world.translation);
+  std::vector<Eigen::Vector2d> points2D;
+  points2D.reserve(rig_image.correspondences.size());
+  for (const Correspondence& correspondence : rig_image.correspondences) {
+    points2D.push_back(correspondence.point2D);
+  }
+  image.SetPoints2D(points2D);
+  model->AddImage(std::move(image));
+  model->RegisterImage(image_id);
+
+  std::unordered_set<colmap::point3D_t> observed;
+  for (size_t k = 0; k < inliers.size(); ++k) {
+    const int64_t point3D_id = rig_image.correspondences[k].point3D_id;
+    if (!inliers[k] || point3D_id < 0) continue;
+    const colmap::point3D_t id = static_cast<colmap::point3D_t>(point3D_id);
+    if (model->ExistsPoint3D(id) && observed.insert(id).second) {
+      model->AddObservation(
+          id,
+          colmap::TrackElement(image_id, static_cast<colmap::point2D_t>(k)));
+    }
+  }
+}
+
+// The calibrated intrinsics of every camera, the dataset's initial ones for
+// a camera that is not calibrated; false unless all are valid with a size.
+bool ModelCameras(const RigDataset& dataset, const RigCalibration& calibration,
+                  std::vector<colmap::Camera>* cameras, std::string* error) {
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    cameras->push_back(calibration.camera_calibrated[c]
+                           ? calibration.cameras[c]
+                           : dataset.cameras[c].camera);
+    if (!ValidIntrinsics(cameras->back())) {
+      *error = "the camera " + dataset.cameras[c].name +
+               " has invalid intrinsics or no image size";
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
@@ -88,25 +141,13 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
     return false;
   }
   const size_t num_cameras = dataset.cameras.size();
-  std::vector<colmap::Camera> cameras(num_cameras);
-  for (size_t c = 0; c < num_cameras; ++c) {
-    cameras[c] = calibration.camera_calibrated[c] ? calibration.cameras[c]
-                                                  : dataset.cameras[c].camera;
-    if (!ValidIntrinsics(cameras[c])) {
-      *error = "the camera " + dataset.cameras[c].name +
-               " has invalid intrinsics or no image size";
-      return false;
-    }
-  }
+  std::vector<colmap::Camera> cameras;
+  if (!ModelCameras(dataset, calibration, &cameras, error)) return false;
 
-  colmap::camera_t max_camera_id = 0;
-  for (const auto& [camera_id, camera] : map.Cameras()) {
-    max_camera_id = std::max(max_camera_id, camera_id);
-  }
-  colmap::image_t max_image_id = 0;
+  const colmap::camera_t max_camera_id = MaxCameraId(map);
+  const colmap::image_t max_image_id = MaxImageId(map);
   std::unordered_set<std::string> map_names;
   for (const auto& [image_id, image] : map.Images()) {
-    max_image_id = std::max(max_image_id, image_id);
     map_names.insert(image.Name());
   }
   // Keep clear of kInvalidCameraId/kInvalidImageId (the uint32 maximum) and
@@ -170,39 +211,66 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
     ModelRig::Frame& frame = rig.frames[frame_of_frameset[f]];
     const Rigid3d cam_from_world = *rig.cam_from_rig[c] * frame.rig_from_world;
 
-    colmap::Image image;
-    image.SetImageId(max_image_id + 1 + static_cast<colmap::image_t>(i));
-    image.SetName(rig_image.name);
-    image.SetCameraId(rig.camera_ids[c]);
-    image.SetQvec(cam_from_world.Qvec());
-    image.SetTvec(cam_from_world.translation);
-    std::vector<Eigen::Vector2d> points2D;
-    points2D.reserve(rig_image.correspondences.size());
-    for (const Correspondence& correspondence : rig_image.correspondences) {
-      points2D.push_back(correspondence.point2D);
-    }
-    image.SetPoints2D(points2D);
-    const colmap::image_t image_id = image.ImageId();
-    model.AddImage(std::move(image));
-    model.RegisterImage(image_id);
+    const colmap::image_t image_id =
+        max_image_id + 1 + static_cast<colmap::image_t>(i);
+    AddRigImage(rig_image, calibration.images[i].inlier_mask, image_id,
+                rig.camera_ids[c], cam_from_world, &model);
     rig_model->image_ids[i] = image_id;
     frame.image_ids.push_back(image_id);
-
-    const std::vector<char>& inliers = calibration.images[i].inlier_mask;
-    std::unordered_set<colmap::point3D_t> observed;
-    for (size_t k = 0; k < inliers.size(); ++k) {
-      const int64_t point3D_id = rig_image.correspondences[k].point3D_id;
-      if (!inliers[k] || point3D_id < 0) continue;
-      const colmap::point3D_t id = static_cast<colmap::point3D_t>(point3D_id);
-      if (model.ExistsPoint3D(id) && observed.insert(id).second) {
-        model.AddObservation(
-            id,
-            colmap::TrackElement(image_id, static_cast<colmap::point2D_t>(k)));
-      }
-    }
   }
   return true;
 }
+
+namespace {
+
+// What COLMAP's rig tools will make of the exported configs: the snapshots
+// COLMAP 3.8's rig_bundle_adjuster will group (by name) where they differ
+// from the framesets, and the frames rig_configurator (>= 3.12) will miss.
+std::vector<std::string> RigConfigNotes(const RigModel& rig_model,
+                                        const RigDescription& rig,
+                                        const bool reference_calibrated) {
+  std::vector<std::string> new_notes;
+  if (reference_calibrated) {
+    const RigBundleAdjusterGrouping grouping =
+        PredictRigBundleAdjusterGrouping(rig, rig_model.model);
+    int num_multi_image_frames = 0;
+    for (const ModelRig::Frame& frame : rig_model.rig.frames) {
+      num_multi_image_frames += frame.image_ids.size() > 1 ? 1 : 0;
+    }
+    if (grouping.num_multi_image_snapshots != num_multi_image_frames ||
+        !grouping.problems.empty()) {
+      new_notes.push_back(
+          std::string(kRigBundleAdjusterConfigFile) +
+          ": COLMAP 3.8 rig_bundle_adjuster groups images by name and will "
+          "see " +
+          std::to_string(grouping.num_multi_image_snapshots) +
+          " snapshots with two images or more, where this calibration has " +
+          std::to_string(num_multi_image_frames) + " such framesets");
+    }
+    for (const std::string& problem : grouping.problems) {
+      new_notes.push_back(
+          std::string(kRigBundleAdjusterConfigFile) +
+          ": COLMAP 3.8 rig_bundle_adjuster would abort: " + problem);
+    }
+  } else {
+    new_notes.push_back(std::string(kRigBundleAdjusterConfigFile) +
+                        " is not written: the reference camera is not "
+                        "calibrated");
+  }
+  const int num_renamed_frames = CountFramesWithDifferentKeys(rig_model, rig);
+  if (num_renamed_frames > 0) {
+    new_notes.push_back(
+        std::string(kRigConfigFile) + ": " +
+        std::to_string(num_renamed_frames) +
+        " framesets pair images with different names after the camera "
+        "prefix (timestamp matching); COLMAP's rig_configurator groups frames "
+        "by identical names and will not find them (frames.* hold them)");
+  }
+
+  return new_notes;
+}
+
+}  // namespace
 
 bool WriteRigOutput(const std::string& output_path,
                     const colmap::Reconstruction& map,
@@ -245,45 +313,10 @@ bool WriteRigOutput(const std::string& output_path,
     }
   }
 
-  std::vector<std::string> new_notes;
   const bool reference_calibrated =
       rig.cameras[rig.reference_camera].camera.has_value();
-  if (reference_calibrated) {
-    const RigBundleAdjusterGrouping grouping =
-        PredictRigBundleAdjusterGrouping(rig, rig_model.model);
-    int num_multi_image_frames = 0;
-    for (const ModelRig::Frame& frame : rig_model.rig.frames) {
-      num_multi_image_frames += frame.image_ids.size() > 1 ? 1 : 0;
-    }
-    if (grouping.num_multi_image_snapshots != num_multi_image_frames ||
-        !grouping.problems.empty()) {
-      new_notes.push_back(
-          std::string(kRigBundleAdjusterConfigFile) +
-          ": COLMAP 3.8 rig_bundle_adjuster groups images by name and will "
-          "see " +
-          std::to_string(grouping.num_multi_image_snapshots) +
-          " snapshots with two images or more, where this calibration has " +
-          std::to_string(num_multi_image_frames) + " such framesets");
-    }
-    for (const std::string& problem : grouping.problems) {
-      new_notes.push_back(
-          std::string(kRigBundleAdjusterConfigFile) +
-          ": COLMAP 3.8 rig_bundle_adjuster would abort: " + problem);
-    }
-  } else {
-    new_notes.push_back(std::string(kRigBundleAdjusterConfigFile) +
-                        " is not written: the reference camera is not "
-                        "calibrated");
-  }
-  const int num_renamed_frames = CountFramesWithDifferentKeys(rig_model, rig);
-  if (num_renamed_frames > 0) {
-    new_notes.push_back(
-        std::string(kRigConfigFile) + ": " +
-        std::to_string(num_renamed_frames) +
-        " framesets pair images with different names after the camera "
-        "prefix (timestamp matching); COLMAP's rig_configurator groups frames "
-        "by identical names and will not find them (frames.* hold them)");
-  }
+  std::vector<std::string> new_notes =
+      RigConfigNotes(rig_model, rig, reference_calibrated);
 
   auto write_contents = [&](const std::string& folder, std::string* error) {
     if (binary) {

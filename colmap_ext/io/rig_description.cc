@@ -12,15 +12,9 @@ bool IsFinite(const Rigid3d& pose) {
 bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
                                     const RigCalibration& calibration,
                                     std::string* error) {
+  if (!ValidateDataset(dataset, error)) return false;
   const size_t num_cameras = dataset.cameras.size();
   const size_t num_framesets = dataset.frameset_names.size();
-  if (num_cameras == 0 || dataset.reference_camera < 0 ||
-      dataset.reference_camera >= static_cast<int>(num_cameras)) {
-    *error =
-        "the dataset has no cameras or its reference camera is out of "
-        "range";
-    return false;
-  }
   if (calibration.cameras.size() != num_cameras ||
       calibration.cam_from_rig.size() != num_cameras ||
       calibration.camera_calibrated.size() != num_cameras ||
@@ -52,14 +46,6 @@ bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
   }
   for (size_t i = 0; i < dataset.images.size(); ++i) {
     const RigImage& image = dataset.images[i];
-    if (image.camera_index < 0 ||
-        image.camera_index >= static_cast<int>(num_cameras) ||
-        image.frameset_index < 0 ||
-        image.frameset_index >= static_cast<int>(num_framesets)) {
-      *error = "the image " + image.name +
-               " has a camera or frameset index out of range";
-      return false;
-    }
     const std::vector<char>& mask = calibration.images[i].inlier_mask;
     if (!mask.empty() && mask.size() != image.correspondences.size()) {
       *error = "the image " + image.name + " has " +

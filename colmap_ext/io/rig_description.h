@@ -32,10 +32,10 @@ struct RigDescription {
   int reference_camera = 0;  // its cam_from_rig is the identity
 };
 
-// Fails unless `calibration` has one entry per camera, frameset and image of
-// `dataset`, every image's camera and frameset index is in range, every
-// inlier mask is empty or has one entry per correspondence, and all poses are
-// finite. The functions below and the writers assume this.
+// Fails unless `dataset` is valid (ValidateDataset) and `calibration` has one
+// entry per camera, frameset and image of it, every inlier mask is empty or
+// has one entry per correspondence, and all poses are finite. The functions
+// below and the writers assume this.
 bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
                                     const RigCalibration& calibration,
                                     std::string* error);

@@ -129,6 +129,26 @@ std::vector<std::vector<int>> ClusterTimestamps(
   return clusters;
 }
 
+// False with "<an_item> is empty" or "<the_item> <name> <twice>" unless
+// every name is non-empty and given once.
+bool CheckUniqueAndNonEmpty(const std::vector<std::string>& names,
+                            const std::string& an_item,
+                            const std::string& the_item,
+                            const std::string& twice, std::string* error) {
+  std::unordered_set<std::string> unique_names;
+  for (const std::string& name : names) {
+    if (name.empty()) {
+      *error = an_item + " is empty";
+      return false;
+    }
+    if (!unique_names.insert(name).second) {
+      *error = the_item + " " + name + " " + twice;
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool NaturalLess(const std::string& a, const std::string& b) {
@@ -182,16 +202,9 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
     *error = "timestamp_tolerance must be a finite number >= 0";
     return false;
   }
-  std::unordered_set<std::string> unique_names;
-  for (const std::string& name : image_names) {
-    if (name.empty()) {
-      *error = "an image name is empty";
-      return false;
-    }
-    if (!unique_names.insert(name).second) {
-      *error = "the image name " + name + " appears twice";
-      return false;
-    }
+  if (!CheckUniqueAndNonEmpty(image_names, "an image name", "the image name",
+                              "appears twice", error)) {
+    return false;
   }
 
   // Cameras.
@@ -212,18 +225,10 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
       return false;
     }
     prefixes.assign(folders.begin(), folders.end());
-  } else {
-    std::unordered_set<std::string> unique_prefixes;
-    for (const std::string& prefix : prefixes) {
-      if (prefix.empty()) {
-        *error = "a camera prefix is empty";
-        return false;
-      }
-      if (!unique_prefixes.insert(prefix).second) {
-        *error = "the camera prefix " + prefix + " is given twice";
-        return false;
-      }
-    }
+  } else if (!CheckUniqueAndNonEmpty(prefixes, "a camera prefix",
+                                     "the camera prefix", "is given twice",
+                                     error)) {
+    return false;
   }
   std::sort(prefixes.begin(), prefixes.end(), NaturalLess);
   const int num_cameras = static_cast<int>(prefixes.size());

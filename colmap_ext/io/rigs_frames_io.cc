@@ -11,6 +11,7 @@
 #include <unordered_set>
 
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/number_text.h"
 
 namespace rig_calibrator {
@@ -83,7 +84,18 @@ class BinaryReader {
     }
     return value;
   }
-  Rigid3d ReadPose() {
+  // The accessors of TokenReader, for ReadFrame.
+  template <typename T>
+  T NextInteger() {
+    return Read<T>();
+  }
+  ColmapSensorId NextSensor() {
+    ColmapSensorId sensor;
+    sensor.type = Read<int32_t>();
+    sensor.id = Read<uint32_t>();
+    return sensor;
+  }
+  Rigid3d NextPose() {
     double v[7];
     for (double& value : v) value = Read<double>();
     return Rigid3d(Eigen::Quaterniond(v[0], v[1], v[2], v[3]),
@@ -160,6 +172,25 @@ class TokenReader {
   bool ok_ = true;
 };
 
+// A frame record, the same fields in frames.txt and frames.bin: frame id, rig
+// id, rig_from_world, the number of data, then per data its sensor and id.
+// Reader: TokenReader or BinaryReader (check ok() after).
+template <typename Reader>
+ColmapFrame ReadFrame(Reader* reader) {
+  ColmapFrame frame;
+  frame.frame_id = reader->template NextInteger<uint32_t>();
+  frame.rig_id = reader->template NextInteger<uint32_t>();
+  frame.rig_from_world = reader->NextPose();
+  const uint32_t num_data = reader->template NextInteger<uint32_t>();
+  for (uint32_t d = 0; reader->ok() && d < num_data; ++d) {
+    ColmapFrameData data;
+    data.sensor = reader->NextSensor();
+    data.data_id = reader->template NextInteger<uint64_t>();
+    frame.data.push_back(data);
+  }
+  return frame;
+}
+
 // Calls `parse_line` for every data line of a text file (not blank, not a
 // '#' comment) with its line number.
 template <typename ParseLine>
@@ -222,17 +253,7 @@ bool ReadText(const std::string& folder, ColmapRigsAndFrames* rigs_frames,
       frames_path,
       [&](const std::string& line, int line_number) {
         TokenReader tokens(line);
-        ColmapFrame frame;
-        frame.frame_id = tokens.NextInteger<uint32_t>();
-        frame.rig_id = tokens.NextInteger<uint32_t>();
-        frame.rig_from_world = tokens.NextPose();
-        const uint32_t num_data = tokens.NextInteger<uint32_t>();
-        for (uint32_t d = 0; tokens.ok() && d < num_data; ++d) {
-          ColmapFrameData data;
-          data.sensor = tokens.NextSensor();
-          data.data_id = tokens.NextInteger<uint64_t>();
-          frame.data.push_back(data);
-        }
+        ColmapFrame frame = ReadFrame(&tokens);
         if (!tokens.ok() || !tokens.AtEnd()) {
           return fail(frames_path, line_number);
         }
@@ -255,15 +276,13 @@ bool ReadBinary(const std::string& folder, ColmapRigsAndFrames* rigs_frames,
     rig.rig_id = rigs.Read<uint32_t>();
     const uint32_t num_sensors = rigs.Read<uint32_t>();
     if (num_sensors > 0) {
-      rig.ref_sensor.type = rigs.Read<int32_t>();
-      rig.ref_sensor.id = rigs.Read<uint32_t>();
+      rig.ref_sensor = rigs.NextSensor();
     }
     for (uint32_t s = 1; rigs.ok() && s < num_sensors; ++s) {
       ColmapRigSensor sensor;
-      sensor.sensor.type = rigs.Read<int32_t>();
-      sensor.sensor.id = rigs.Read<uint32_t>();
+      sensor.sensor = rigs.NextSensor();
       if (rigs.Read<uint8_t>() != 0) {
-        sensor.sensor_from_rig = rigs.ReadPose();
+        sensor.sensor_from_rig = rigs.NextPose();
       }
       rig.sensors.push_back(sensor);
     }
@@ -279,19 +298,7 @@ bool ReadBinary(const std::string& folder, ColmapRigsAndFrames* rigs_frames,
   BinaryReader frames(frames_bytes);
   const uint64_t num_frames = frames.Read<uint64_t>();
   for (uint64_t f = 0; frames.ok() && f < num_frames; ++f) {
-    ColmapFrame frame;
-    frame.frame_id = frames.Read<uint32_t>();
-    frame.rig_id = frames.Read<uint32_t>();
-    frame.rig_from_world = frames.ReadPose();
-    const uint32_t num_data = frames.Read<uint32_t>();
-    for (uint32_t d = 0; frames.ok() && d < num_data; ++d) {
-      ColmapFrameData data;
-      data.sensor.type = frames.Read<int32_t>();
-      data.sensor.id = frames.Read<uint32_t>();
-      data.data_id = frames.Read<uint64_t>();
-      frame.data.push_back(data);
-    }
-    rigs_frames->frames.push_back(std::move(frame));
+    rigs_frames->frames.push_back(ReadFrame(&frames));
   }
   if (!frames.ok() || !frames.AtEnd()) {
     *error = frames_path + " is truncated or has trailing bytes";
@@ -325,14 +332,8 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
     }
   }
 
-  colmap::camera_t max_camera_id = 0;
-  for (const auto& [camera_id, camera] : model.Cameras()) {
-    max_camera_id = std::max(max_camera_id, camera_id);
-  }
-  colmap::image_t max_image_id = 0;
-  for (const auto& [image_id, image] : model.Images()) {
-    max_image_id = std::max(max_image_id, image_id);
-  }
+  const colmap::camera_t max_camera_id = MaxCameraId(model);
+  const colmap::image_t max_image_id = MaxImageId(model);
   if (static_cast<uint64_t>(max_camera_id) + 1 >=
           std::numeric_limits<uint32_t>::max() ||
       static_cast<uint64_t>(max_image_id) + rig.frames.size() >=

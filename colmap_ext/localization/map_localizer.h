@@ -17,11 +17,11 @@
 // Everything is read from the database; nothing is ever written to it.
 //
 // Why direct is the default (measured with the disabled benchmark in
-// tests/colmap_ext/localization/map_localizer_test.cc, map of 300 images x 2000 features,
-// rig images of 2000 features): direct costs 0.26 CPU s per image (index of
-// 360k descriptors built in ~3 s), i.e. ~7.5 images/s on 2 cores; retrieval
-// with 10 map images costs 1.85 CPU s per image. These are with 128 FLANN
-// checks; the default 64 (`index.num_checks`) halves the direct cost.
+// tests/colmap_ext/localization/map_localizer_test.cc, map of 300 images x 2000
+// features, rig images of 2000 features): direct costs 0.26 CPU s per image
+// (index of 360k descriptors built in ~3 s), i.e. ~7.5 images/s on 2 cores;
+// retrieval with 10 map images costs 1.85 CPU s per image. These are with 128
+// FLANN checks; the default 64 (`index.num_checks`) halves the direct cost.
 #pragma once
 
 #include <colmap/base/reconstruction.h>
@@ -34,6 +34,8 @@
 #include <vector>
 
 #include "colmap_ext/io/database_reader.h"
+#include "colmap_ext/localization/correspondence_selection.h"
+#include "colmap_ext/localization/localization_map.h"
 #include "colmap_ext/localization/point_descriptor_index.h"
 #include "src/calibration/rig_dataset.h"
 
@@ -101,23 +103,6 @@ struct ImageLocalization {
   double seconds = 0;
 };
 
-// One candidate 2D-3D match. `votes` counts the map images (or index hits)
-// that support it; `angle` is its SIFT descriptor distance (radians).
-struct CorrespondenceCandidate {
-  colmap::point2D_t point2D_idx = colmap::kInvalidPoint2DIdx;
-  colmap::point3D_t point3D_id = colmap::kInvalidPoint3DId;
-  int votes = 1;
-  float angle = 0;
-};
-
-// A one-to-one subset of the candidates: candidates of the same
-// (keypoint, point) pair are merged (votes summed, smallest angle kept), then
-// pairs are accepted greedily from the best (most votes, then smallest angle,
-// then smallest keypoint and point ids) while neither their keypoint nor their
-// point is taken.
-std::vector<CorrespondenceCandidate> SelectOneToOneCorrespondences(
-    std::vector<CorrespondenceCandidate> candidates);
-
 class MapLocalizer {
  public:
   // Reads, for every registered map image, the descriptors of its keypoints
@@ -141,20 +126,16 @@ class MapLocalizer {
                       std::vector<ImageLocalization>* results,
                       std::string* error) const;
 
-  size_t NumMapImages() const { return map_image_ids_.size(); }
-  size_t NumMapPoints() const { return map_points_.size(); }
+  size_t NumMapImages() const { return map_.image_ids.size(); }
+  size_t NumMapPoints() const { return map_.points.size(); }
   size_t NumIndexedDescriptors() const { return point_index_.NumDescriptors(); }
 
  private:
   class VocabTree;
-  struct MapPoint {
-    Eigen::Vector3d xyz;
-    std::vector<colmap::image_t> image_ids;  // database ids of its track
-  };
 
   MapLocalizer(const MapLocalizerOptions& options,
                const DatabaseReader* database);
-  bool ReadMap(const colmap::Reconstruction& map, std::string* error);
+  // map_localizer_matching.cc: the sources of correspondences.
   bool BuildVocabTree(std::string* error);
   bool CheckImageFeatures(const DatabaseImage& image, std::string* error) const;
   bool LocalizeImage(const DatabaseImage& image, ImageLocalization* result,
@@ -175,12 +156,7 @@ class MapLocalizer {
 
   MapLocalizerOptions options_;
   const DatabaseReader* database_;
-  // Registered map images (database ids), sorted, and per image the map
-  // point of every keypoint (kInvalidPoint3DId: none).
-  std::vector<colmap::image_t> map_image_ids_;
-  std::unordered_map<colmap::image_t, std::vector<colmap::point3D_t>>
-      map_image_point3D_ids_;
-  std::unordered_map<colmap::point3D_t, MapPoint> map_points_;
+  LocalizationMap map_;
   PointDescriptorIndex point_index_;
   std::unique_ptr<VocabTree> vocab_tree_;
   // Whether two_view_geometries holds any verified pair at all.

@@ -54,8 +54,16 @@ TEST(RuntimeBenchmark, CalibrationRuntimeRoundTrips) {
   EXPECT_FALSE(parsed.success);
   // The message stays on one line.
   EXPECT_EQ(parsed.error, "the radial rig initialization failed: no seed");
+  EXPECT_DOUBLE_EQ(parsed.generation_seconds, 0.25);
+  EXPECT_DOUBLE_EQ(parsed.final_rms_px, 0.705);
+  EXPECT_DOUBLE_EQ(parsed.max_rotation_error_deg, 0.02);
+  EXPECT_DOUBLE_EQ(parsed.max_center_error_m, 0.0005);
   ASSERT_EQ(parsed.stages.size(), 2u);
+  EXPECT_EQ(parsed.stages[0].stage, "Single-image localization");
+  EXPECT_DOUBLE_EQ(parsed.stages[0].seconds, 0.5);
+  EXPECT_DOUBLE_EQ(parsed.stages[0].cpu_seconds, 0.9);
   EXPECT_EQ(parsed.stages[1].stage, "Final bundle adjustment");
+  EXPECT_NEAR(parsed.stages[1].seconds, 41.5 / 3, 1e-8);
   EXPECT_NEAR(parsed.stages[1].cpu_seconds, 41.5 / 2, 1e-8);
 
   EXPECT_FALSE(ParseCalibrationRuntime("something else\n", &parsed, &error));
@@ -82,15 +90,27 @@ TEST(RuntimeBenchmark, LocalizationRuntimeRoundTrips) {
   run.precision = 0.99;
   run.radial_pose_seconds_per_image = 0.002;
   run.num_poses_correct = 39;
+  run.index_cpu_seconds = 6.25;
   LocalizationRuntime parsed;
   std::string error;
   ASSERT_TRUE(ParseLocalizationRuntime(SerializeLocalizationRuntime(run),
                                        &parsed, &error))
       << error;
   EXPECT_EQ(parsed.mode, "direct");
+  EXPECT_EQ(parsed.num_map_images, 300);
+  EXPECT_EQ(parsed.num_map_points, 90000);
   EXPECT_EQ(parsed.num_indexed_descriptors, 360000);
-  EXPECT_EQ(parsed.num_poses_correct, 39);
+  EXPECT_EQ(parsed.features_per_rig_image, 2000);
   EXPECT_EQ(parsed.num_checks, 64);
+  EXPECT_EQ(parsed.num_images, 40);
+  EXPECT_DOUBLE_EQ(parsed.index_seconds, 3.5);
+  EXPECT_DOUBLE_EQ(parsed.index_cpu_seconds, 6.25);
+  EXPECT_DOUBLE_EQ(parsed.seconds, 5);
+  EXPECT_DOUBLE_EQ(parsed.cpu_seconds, 9.5);
+  EXPECT_DOUBLE_EQ(parsed.recall, 0.97);
+  EXPECT_DOUBLE_EQ(parsed.precision, 0.99);
+  EXPECT_DOUBLE_EQ(parsed.radial_pose_seconds_per_image, 0.002);
+  EXPECT_EQ(parsed.num_poses_correct, 39);
   EXPECT_DOUBLE_EQ(parsed.ImagesPerSecond(), 8.0);
   EXPECT_FALSE(ParseLocalizationRuntime(
       SerializeCalibrationRuntime(MakeRun(10, 5, 1)), &parsed, &error));
@@ -116,6 +136,39 @@ TEST(RuntimeBenchmark, CsvHasOneColumnPairPerStageAndOneRowPerRun) {
   EXPECT_EQ(lines[1].rfind("10,5,50,15000,1,0.500,0.900,", 0), 0u);
   EXPECT_NE(lines[1].find(",,,"), std::string::npos);  // no Rig init.
   EXPECT_NE(lines[2].find(",0.125,0.250,"), std::string::npos);
+}
+
+TEST(RuntimeBenchmark, LocalizationTablesGiveCpuSecondsPerImage) {
+  LocalizationRuntime run;
+  run.mode = "retrieval";
+  run.num_checks = 64;
+  run.num_images = 40;
+  run.seconds = 5;
+  run.cpu_seconds = 10;
+  LocalizationRuntime empty = run;
+  empty.num_images = 0;
+  const std::vector<std::string> csv =
+      Lines(LocalizationRuntimeCsv({run, empty}));
+  ASSERT_EQ(csv.size(), 3u);
+  // Columns 12 and 13 (from 0): images per s = 40 / 5, CPU s per image =
+  // 10 / 40; without images neither is defined.
+  const auto column = [](const std::string& line, int index) {
+    std::stringstream stream(line);
+    std::string cell;
+    for (int i = 0; i <= index; ++i) std::getline(stream, cell, ',');
+    return cell;
+  };
+  EXPECT_EQ(column(csv[0], 11), "images per s");
+  EXPECT_EQ(column(csv[0], 12), "CPU s per image");
+  EXPECT_EQ(column(csv[1], 11), "8.00");
+  EXPECT_EQ(column(csv[1], 12), "0.2500");
+  EXPECT_EQ(column(csv[2], 12), "-");
+  // The Markdown table shows the checks of direct runs only.
+  const std::string markdown = LocalizationRuntimeMarkdown({run});
+  EXPECT_NE(markdown.find("| retrieval | 0 | 0 | 0 | - | 40 |"),
+            std::string::npos)
+      << markdown;
+  EXPECT_NE(markdown.find("| 8.00 | 0.250 |"), std::string::npos) << markdown;
 }
 
 TEST(RuntimeBenchmark, GrowthExponentOfPowerLaws) {

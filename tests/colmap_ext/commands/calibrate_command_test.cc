@@ -6,7 +6,6 @@
 #include <colmap/base/database.h>
 #include <colmap/base/reconstruction.h>
 #include <gtest/gtest.h>
-#include <sqlite3.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "colmap_ext/commands/commands.h"
+#include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -43,23 +43,7 @@ std::map<std::string, std::string> Snapshot(const std::string& folder) {
   return files;
 }
 
-void ExecuteSql(const std::string& path, const std::string& sql) {
-  sqlite3* database = nullptr;
-  ASSERT_EQ(sqlite3_open(path.c_str(), &database), SQLITE_OK);
-  char* message = nullptr;
-  EXPECT_EQ(sqlite3_exec(database, sql.c_str(), nullptr, nullptr, &message),
-            SQLITE_OK)
-      << (message != nullptr ? message : "");
-  sqlite3_free(message);
-  sqlite3_close(database);
-}
-
-int RunCalibrateWith(std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), "rig_calibrator");
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  return RunCalibrate(static_cast<int>(argv.size()), argv.data());
-}
+using testing::ExecuteSql;
 
 // Features of one image: keypoints on a grid, descriptors from `random`.
 void WriteFeatures(colmap::Database* database, const colmap::image_t image_id,
@@ -189,7 +173,7 @@ class CalibrateCommandBadInput : public ::testing::Test {
         Snapshot(temp_.path());
     ::testing::internal::CaptureStderr();
     ::testing::internal::CaptureStdout();
-    const int exit_code = RunCalibrateWith(arguments);
+    const int exit_code = testing::RunCommand(&RunCalibrate, arguments);
     const std::string output = ::testing::internal::GetCapturedStdout();
     const std::string messages = ::testing::internal::GetCapturedStderr();
     ASSERT_NE(messages.find("ERROR: "), std::string::npos) << messages;

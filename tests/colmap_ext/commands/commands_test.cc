@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "colmap_ext/io/map_reader.h"
+#include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -21,13 +22,7 @@ namespace {
 
 namespace fs = boost::filesystem;
 
-int RunCommand(int (*command)(int, char**),
-               std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), "rig_calibrator");
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  return command(static_cast<int>(argv.size()), argv.data());
-}
+using testing::RunCommand;
 
 class CommandsTest : public ::testing::Test {
  protected:

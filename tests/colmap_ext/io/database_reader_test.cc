@@ -2,13 +2,13 @@
 
 #include <colmap/base/database.h>
 #include <gtest/gtest.h>
-#include <sqlite3.h>
 
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <set>
 
+#include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -16,18 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Runs SQL on a database the test owns (never on a database under test
-// through the reader).
-void ExecuteSql(const std::string& path, const std::string& sql) {
-  sqlite3* database = nullptr;
-  ASSERT_EQ(sqlite3_open(path.c_str(), &database), SQLITE_OK);
-  char* message = nullptr;
-  EXPECT_EQ(sqlite3_exec(database, sql.c_str(), nullptr, nullptr, &message),
-            SQLITE_OK)
-      << (message != nullptr ? message : "");
-  sqlite3_free(message);
-  sqlite3_close(database);
-}
+using testing::ExecuteSql;
 
 colmap::FeatureDescriptors RandomDescriptors(const int rows, const int seed) {
   colmap::FeatureDescriptors descriptors(rows, 128);

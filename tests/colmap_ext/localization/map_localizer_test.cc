@@ -17,6 +17,7 @@
 #include <random>
 #include <set>
 
+#include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -59,43 +60,6 @@ struct SyntheticScene {
   colmap::FeatureDescriptors all_map_descriptors;
 };
 
-class DescriptorGenerator {
- public:
-  explicit DescriptorGenerator(const unsigned seed) : random_(seed) {}
-
-  // Half of the bins empty, the rest |N(0,1)|, scaled to L2 norm 512.
-  Eigen::VectorXf RandomBase() {
-    Eigen::VectorXf base(128);
-    for (int j = 0; j < 128; ++j) {
-      base(j) = coin_(random_) ? std::abs(normal_(random_)) : 0.0f;
-    }
-    return base * (512.0f / std::max(base.norm(), 1e-6f));
-  }
-
-  colmap::FeatureDescriptor Observe(const Eigen::VectorXf& base,
-                                    const double noise) {
-    Eigen::VectorXf noisy = base;
-    for (int j = 0; j < 128; ++j) {
-      noisy(j) = std::max(
-          0.0f, noisy(j) + static_cast<float>(noise * normal_(random_)));
-    }
-    noisy *= 512.0f / std::max(noisy.norm(), 1e-6f);
-    colmap::FeatureDescriptor descriptor(1, 128);
-    for (int j = 0; j < 128; ++j) {
-      descriptor(j) =
-          static_cast<uint8_t>(std::min(255.0f, std::round(noisy(j))));
-    }
-    return descriptor;
-  }
-
-  std::mt19937& random() { return random_; }
-
- private:
-  std::mt19937 random_;
-  std::normal_distribution<float> normal_;
-  std::bernoulli_distribution coin_{0.5};
-};
-
 struct Feature {
   colmap::FeatureKeypoint keypoint;
   colmap::FeatureDescriptor descriptor;
@@ -117,7 +81,7 @@ void WriteFeatures(colmap::Database* database, const colmap::image_t image_id,
 SyntheticScene MakeScene(const SceneConfig& config,
                          const std::string& database_path) {
   SyntheticScene scene;
-  DescriptorGenerator generator(config.seed);
+  testing::SiftLikeDescriptors generator(config.seed);
   std::mt19937& random = generator.random();
   std::uniform_real_distribution<float> pixel_x(0.5f, 639.5f);
   std::uniform_real_distribution<float> pixel_y(0.5f, 479.5f);

@@ -6,46 +6,10 @@
 #include <random>
 #include <set>
 
+#include "tests/colmap_ext/colmap_testing.h"
+
 namespace rig_calibrator {
 namespace {
-
-class Descriptors {
- public:
-  explicit Descriptors(const unsigned seed) : random_(seed) {}
-
-  // SIFT-like: half of the bins empty, L2 norm 512.
-  Eigen::VectorXf RandomBase() {
-    Eigen::VectorXf base(128);
-    for (int j = 0; j < 128; ++j) {
-      base(j) = coin_(random_) ? std::abs(normal_(random_)) : 0.0f;
-    }
-    return base * (512.0f / base.norm());
-  }
-
-  colmap::FeatureDescriptor Quantize(const Eigen::VectorXf& vector) {
-    const Eigen::VectorXf scaled = vector * (512.0f / vector.norm());
-    colmap::FeatureDescriptor descriptor(1, 128);
-    for (int j = 0; j < 128; ++j) {
-      descriptor(j) =
-          static_cast<uint8_t>(std::min(255.0f, std::round(scaled(j))));
-    }
-    return descriptor;
-  }
-
-  colmap::FeatureDescriptor Observe(const Eigen::VectorXf& base,
-                                    const float noise) {
-    Eigen::VectorXf noisy = base;
-    for (int j = 0; j < 128; ++j) {
-      noisy(j) = std::max(0.0f, noisy(j) + noise * normal_(random_));
-    }
-    return Quantize(noisy);
-  }
-
- private:
-  std::mt19937 random_;
-  std::normal_distribution<float> normal_;
-  std::bernoulli_distribution coin_{0.5};
-};
 
 TEST(SiftDescriptorAngleTest, FollowsColmapsNormalization) {
   colmap::FeatureDescriptor a = colmap::FeatureDescriptor::Zero(1, 128);
@@ -65,7 +29,7 @@ TEST(SelectRepresentativeDescriptorsTest, CoversDistinctViewpoints) {
   // Rows 0-2 are near copies of one descriptor, rows 3 and 4 of two others:
   // three representatives must cover the three groups, starting with the
   // group that dominates the mean.
-  Descriptors generator(3);
+  testing::SiftLikeDescriptors generator(3);
   const Eigen::VectorXf bases[3] = {
       generator.RandomBase(), generator.RandomBase(), generator.RandomBase()};
   colmap::FeatureDescriptors descriptors(5, 128);
@@ -85,7 +49,7 @@ TEST(SelectRepresentativeDescriptorsTest, CoversDistinctViewpoints) {
 }
 
 TEST(PointDescriptorIndexTest, RatioTestComparesWithOtherPointsOnly) {
-  Descriptors generator(11);
+  testing::SiftLikeDescriptors generator(11);
   const Eigen::VectorXf a = generator.RandomBase();
   const Eigen::VectorXf b = generator.RandomBase();
   const Eigen::VectorXf c = generator.RandomBase();
@@ -131,7 +95,7 @@ TEST(PointDescriptorIndexTest, RatioTestComparesWithOtherPointsOnly) {
 }
 
 TEST(PointDescriptorIndexTest, MatchesTheExhaustiveRuleWithEnoughChecks) {
-  Descriptors generator(5);
+  testing::SiftLikeDescriptors generator(5);
   const int num_points = 400;
   std::vector<Eigen::VectorXf> bases;
   std::vector<colmap::point3D_t> point3D_ids;

@@ -1,0 +1,187 @@
+#include "colmap_ext/commands/calibrate_options.h"
+
+#include <boost/algorithm/string.hpp>
+
+#include "colmap_ext/commands/command_options.h"
+
+namespace rig_calibrator {
+namespace {
+
+namespace po = boost::program_options;
+
+void AddInputOutputOptions(po::options_description* description,
+                           CalibrateOptions* o) {
+  AddUnsetOption(description, "database_path", &o->database_path,
+                 "COLMAP 3.8 database with the map images and the rig "
+                 "images' features (never modified)");
+  AddUnsetOption(description, "image_path", &o->image_path,
+                 "folder of the rig images, one sub-folder per camera "
+                 "(cam0/, cam1/, ...)");
+  AddUnsetOption(description, "input_path", &o->input_path,
+                 "the map: a COLMAP sparse model folder (binary or text)");
+  AddUnsetOption(description, "output_path", &o->output_path,
+                 "output folder (written completely or not at all)");
+  AddUnsetOption(description, "correspondences_path", &o->correspondences_path,
+                 "calibrate from this 2D-3D correspondence file instead of "
+                 "matching against the database (--input_path is then "
+                 "optional)");
+  AddOption(description, "output_type", &o->output_type,
+            "BIN or TXT, for the COLMAP model and rigs/frames files");
+  AddOverwriteOption(description, &o->overwrite);
+}
+
+void AddRigCalibratorOptions(po::options_description* description,
+                             CalibrateOptions* o) {
+  AddOption(description, "RigCalibrator.method", &o->method,
+            "1dr (default, Inf+1DR+RA), rd_ra, rd, known, known_refine");
+  AddOption(description, "RigCalibrator.camera_model", &o->camera_model,
+            "COLMAP camera model of every camera (e.g. OPENCV, "
+            "OPENCV_FISHEYE, FULL_OPENCV, RADIAL), or per camera: "
+            "cam0:OPENCV,cam1:OPENCV_FISHEYE");
+  AddUnsetOption(description, "RigCalibrator.reference_camera",
+                 &o->reference_camera,
+                 "the camera whose frame is the rig frame (default: the "
+                 "first)");
+  AddUnsetOption(description, "RigCalibrator.camera_prefixes",
+                 &o->camera_prefixes,
+                 "comma-separated image name prefixes of the cameras "
+                 "(default: the first-level folders)");
+  AddOption(description, "RigCalibrator.timestamp_tolerance",
+            &o->timestamp_tolerance,
+            "0: a frameset is the images with the same file name; > 0: "
+            "numeric names (e.g. nanosecond timestamps) within this "
+            "tolerance");
+  AddUnsetOption(description, "RigCalibrator.intrinsics_path",
+                 &o->intrinsics_path,
+                 "known intrinsics for the known* methods (rig_config.json "
+                 "with camera_params, or camchain.yaml); default: the "
+                 "database's cameras");
+  AddOption(description, "RigCalibrator.refine_points", &o->refine_points,
+            "also refine the map points that rig images observe at least "
+            "twice in the final bundle adjustment (the result is then "
+            "aligned back to the map by a similarity); 0: keep the map "
+            "points fixed");
+  AddOption(description, "RigCalibrator.radial_max_error",
+            &o->radial_max_error_px,
+            "inlier threshold of the 1D radial stages (pixels)");
+  AddOption(description, "RigCalibrator.max_reprojection_error",
+            &o->max_reprojection_error_px,
+            "inlier threshold of the camera upgrade (pixels)");
+  AddOption(description, "RigCalibrator.loss_scale", &o->loss_scale_px,
+            "Cauchy loss scale of the bundle adjustments (pixels)");
+  AddOption(description, "RigCalibrator.min_num_inliers", &o->min_num_inliers,
+            "images with fewer 2D-3D inliers are not localized");
+  AddOption(description, "RigCalibrator.num_threads", &o->num_threads,
+            "-1: all cores");
+  AddOption(description, "RigCalibrator.seed", &o->seed,
+            "random seed (results are deterministic for a seed)");
+}
+
+void AddLocalizationOptions(po::options_description* description,
+                            CalibrateOptions* o) {
+  AddOption(description, "Localization.mode", &o->localization_mode,
+            "direct: match features to an index of the map points' "
+            "descriptors; retrieval: match to retrieved map images");
+  AddUnsetOption(description, "Localization.vocab_tree_path",
+                 &o->vocab_tree_path,
+                 "COLMAP 3.8 vocabulary tree for retrieval mode (optional)");
+  AddOption(description, "Localization.num_retrieved_images",
+            &o->num_retrieved_images,
+            "map images matched per rig image in retrieval mode");
+  AddOption(description, "Localization.num_checks", &o->num_checks,
+            "direct mode: FLANN leaf checks per rig feature (fewer: faster, "
+            "fewer matches; COLMAP's matcher uses 128, twice the time)");
+  AddOption(description, "Localization.max_descriptors_per_point",
+            &o->max_descriptors_per_point,
+            "direct mode: descriptors indexed per map point");
+  AddOption(description, "Localization.use_database_matches",
+            &o->use_database_matches,
+            "use matches a COLMAP matcher already stored between rig and map "
+            "images");
+  AddOption(description, "SiftMatching.max_ratio", &o->sift_matching.max_ratio,
+            "Lowe's ratio test");
+  AddOption(description, "SiftMatching.max_distance",
+            &o->sift_matching.max_distance,
+            "largest descriptor distance (radians)");
+  AddOption(description, "SiftMatching.cross_check",
+            &o->sift_matching.cross_check,
+            "retrieval mode: keep mutual best matches only");
+}
+
+}  // namespace
+
+po::options_description DescribeCalibrateOptions(CalibrateOptions* options) {
+  po::options_description description =
+      CommandOptions("rig_calibrator [calibrate] options");
+  AddInputOutputOptions(&description, options);
+  AddRigCalibratorOptions(&description, options);
+  AddLocalizationOptions(&description, options);
+  return description;
+}
+
+bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
+                         std::string* error) {
+  if (options->output_path.empty()) {
+    *error = "--output_path is required";
+    return false;
+  }
+  if (!options->FromCorrespondences() &&
+      (options->database_path.empty() || options->image_path.empty() ||
+       options->input_path.empty())) {
+    *error =
+        "give --database_path, --image_path and --input_path (the map), or "
+        "--correspondences_path";
+    return false;
+  }
+  boost::to_upper(options->output_type);
+  if (options->output_type != "BIN" && options->output_type != "TXT") {
+    *error = "--output_type must be BIN or TXT, not " + options->output_type;
+    return false;
+  }
+  if (!CalibrationMethodFromName(options->method, &pipeline->method)) {
+    *error =
+        "--RigCalibrator.method must be one of 1dr, rd_ra, rd, known, "
+        "known_refine, not " +
+        options->method;
+    return false;
+  }
+  pipeline->num_threads = options->num_threads;
+  pipeline->seed = static_cast<unsigned int>(options->seed);
+  pipeline->initial_pose.radial.max_error_px = options->radial_max_error_px;
+  pipeline->initial_pose.min_num_inliers = options->min_num_inliers;
+  pipeline->rig_initializer.max_radial_error_px = options->radial_max_error_px;
+  pipeline->upgrade_radial_max_error_px = options->radial_max_error_px;
+  pipeline->upgrade.max_error_px = options->max_reprojection_error_px;
+  pipeline->initial_pose.upgrade.max_error_px =
+      options->max_reprojection_error_px;
+  pipeline->radial_bundle_adjustment.loss_scale_px = options->loss_scale_px;
+  pipeline->final_bundle_adjustment.loss_scale_px = options->loss_scale_px;
+  pipeline->final_bundle_adjustment.refine_points = options->refine_points;
+  return true;
+}
+
+bool MakeLocalizerOptions(const CalibrateOptions& options,
+                          MapLocalizerOptions* localizer_options,
+                          std::string* error) {
+  if (!LocalizationModeFromName(options.localization_mode,
+                                &localizer_options->mode)) {
+    *error = "--Localization.mode must be direct or retrieval, not " +
+             options.localization_mode;
+    return false;
+  }
+  localizer_options->sift_matching.max_ratio = options.sift_matching.max_ratio;
+  localizer_options->sift_matching.max_distance =
+      options.sift_matching.max_distance;
+  localizer_options->sift_matching.cross_check =
+      options.sift_matching.cross_check;
+  localizer_options->vocab_tree_path = options.vocab_tree_path;
+  localizer_options->num_retrieved_images = options.num_retrieved_images;
+  localizer_options->index.num_checks = options.num_checks;
+  localizer_options->max_descriptors_per_point =
+      options.max_descriptors_per_point;
+  localizer_options->use_database_matches = options.use_database_matches;
+  localizer_options->num_threads = options.num_threads;
+  return localizer_options->Check(error);
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,74 @@
+// The options of `rig_calibrator [calibrate]` and what they set: the
+// pipeline's and the localizer's options.
+#pragma once
+
+#include <colmap/feature/sift.h>
+
+#include <boost/program_options.hpp>
+#include <string>
+
+#include "colmap_ext/localization/map_localizer.h"
+#include "src/calibration/pipeline.h"
+
+namespace rig_calibrator {
+
+struct CalibrateOptions {
+  std::string database_path;
+  std::string image_path;
+  std::string input_path;
+  std::string output_path;
+  std::string correspondences_path;
+  std::string output_type = "BIN";
+  bool overwrite = false;
+
+  std::string method = "1dr";
+  std::string camera_model = "OPENCV";
+  std::string reference_camera;
+  std::string camera_prefixes;
+  double timestamp_tolerance = 0;
+  std::string intrinsics_path;
+  // On: a map built by COLMAP is less accurate than what the rig's own many
+  // observations determine (rendered ring5: rotation 0.055 -> 0.006 deg,
+  // projection difference 0.7 -> 0.08 px); the result stays anchored to the
+  // map by a similarity.
+  bool refine_points = true;
+  double radial_max_error_px = 8.0;
+  double max_reprojection_error_px = 10.0;
+  double loss_scale_px = 1.0;
+  int min_num_inliers = 15;
+  int num_threads = -1;
+  int seed = 0;
+
+  std::string localization_mode = "direct";
+  std::string vocab_tree_path;
+  int num_retrieved_images = 10;
+  int num_checks = PointDescriptorIndex::Options().num_checks;
+  int max_descriptors_per_point =
+      MapLocalizerOptions().max_descriptors_per_point;
+  bool use_database_matches = true;
+  colmap::SiftMatchingOptions sift_matching;
+
+  bool FromCorrespondences() const { return !correspondences_path.empty(); }
+  // The known* methods, which take the intrinsics as given.
+  bool KnownIntrinsics() const {
+    return method == "known" || method == "known_refine";
+  }
+};
+
+// The command-line options, bound to the fields of *options.
+boost::program_options::options_description DescribeCalibrateOptions(
+    CalibrateOptions* options);
+
+// Checks the combination of inputs, upper-cases output_type and sets
+// *pipeline from the options; false with the message (naming the option)
+// in *error.
+bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
+                         std::string* error);
+
+// The localizer's options (Localization.*, SiftMatching.*); false with
+// *error for an unknown mode or values out of range.
+bool MakeLocalizerOptions(const CalibrateOptions& options,
+                          MapLocalizerOptions* localizer_options,
+                          std::string* error);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,378 @@
+#include "colmap_ext/commands/calibration_input.h"
+
+#include <colmap/base/camera_models.h>
+#include <colmap/util/timer.h>
+
+#include <algorithm>
+#include <boost/algorithm/string.hpp>
+#include <boost/filesystem.hpp>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "colmap_ext/io/correspondence_io.h"
+#include "colmap_ext/io/database_reader.h"
+#include "colmap_ext/io/rig_reference_io.h"
+#include "colmap_ext/localization/map_localizer.h"
+#include "src/calibration/camera_upgrader.h"
+
+namespace rig_calibrator {
+namespace {
+
+namespace fs = boost::filesystem;
+
+bool IsImageFile(const fs::path& path) {
+  std::string extension = path.extension().string();
+  boost::algorithm::to_lower(extension);
+  static const std::vector<std::string> kExtensions = {
+      ".png", ".jpg", ".jpeg", ".pgm", ".ppm", ".bmp", ".tif", ".tiff"};
+  return std::find(kExtensions.begin(), kExtensions.end(), extension) !=
+         kExtensions.end();
+}
+
+// Image names relative to `image_path`, with '/', sorted.
+bool ListImages(const std::string& image_path, std::vector<std::string>* names,
+                std::string* error) {
+  boost::system::error_code fs_error;
+  if (!fs::is_directory(image_path, fs_error)) {
+    *error =
+        "--image_path " + image_path + " does not exist or is not a folder";
+    return false;
+  }
+  const fs::path root = fs::canonical(image_path, fs_error);
+  fs::recursive_directory_iterator it(root, fs_error), end;
+  for (; !fs_error && it != end; it.increment(fs_error)) {
+    boost::system::error_code ignored;
+    if (!fs::is_regular_file(it->path(), ignored) || !IsImageFile(it->path())) {
+      continue;
+    }
+    // Lexically: fs::relative would resolve a symlinked image to its target,
+    // whereas COLMAP names it by its path under the image folder.
+    names->push_back(it->path().lexically_relative(root).generic_string());
+  }
+  if (fs_error) {
+    *error = "cannot list the images under --image_path " + image_path + ": " +
+             fs_error.message();
+    return false;
+  }
+  std::sort(names->begin(), names->end());
+  if (names->empty()) {
+    *error = "no images (png, jpg, pgm, ppm, bmp, tif) under --image_path " +
+             image_path;
+    return false;
+  }
+  return true;
+}
+
+// "OPENCV" for every camera, or "cam0:OPENCV,cam1:OPENCV_FISHEYE".
+bool CameraModels(const std::string& value,
+                  const std::vector<std::string>& camera_names,
+                  std::vector<std::string>* models, std::string* error) {
+  models->assign(camera_names.size(), "");
+  std::vector<std::string> items;
+  boost::split(items, value, boost::is_any_of(","));
+  for (std::string item : items) {
+    boost::trim(item);
+    if (item.empty()) continue;
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos) {
+      for (std::string& model : *models) {
+        if (model.empty()) model = item;
+      }
+      continue;
+    }
+    const std::string camera = item.substr(0, colon);
+    const auto it = std::find(camera_names.begin(), camera_names.end(), camera);
+    if (it == camera_names.end()) {
+      *error = "--RigCalibrator.camera_model names camera '" + camera +
+               "', which is not a camera of the rig";
+      return false;
+    }
+    (*models)[it - camera_names.begin()] = item.substr(colon + 1);
+  }
+  for (size_t c = 0; c < models->size(); ++c) {
+    const std::string& model = (*models)[c];
+    if (model.empty()) {
+      *error = "--RigCalibrator.camera_model gives no model for camera " +
+               camera_names[c];
+      return false;
+    }
+    if (!colmap::ExistsCameraModelWithName(model) ||
+        !IsUpgradeSupportedCameraModel(colmap::CameraModelNameToId(model))) {
+      *error = "unknown or unsupported camera model '" + model +
+               "' for camera " + camera_names[c] +
+               "; supported: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, "
+               "OPENCV, OPENCV_FISHEYE, FULL_OPENCV, SIMPLE_RADIAL_FISHEYE, "
+               "RADIAL_FISHEYE";
+      return false;
+    }
+  }
+  return true;
+}
+
+// Builds the dataset's cameras, framesets and images (without
+// correspondences) from the rig layout of `image_names`, which come from
+// `source` (named in the messages).
+bool MakeDataset(const CalibrateOptions& options, const std::string& source,
+                 const std::vector<std::string>& image_names,
+                 const std::vector<std::pair<int, int>>& image_sizes,
+                 RigDataset* dataset, RigLayout* layout, std::string* error) {
+  RigLayoutOptions layout_options;
+  layout_options.timestamp_tolerance = options.timestamp_tolerance;
+  if (!options.camera_prefixes.empty()) {
+    boost::split(layout_options.camera_prefixes, options.camera_prefixes,
+                 boost::is_any_of(","));
+  }
+  if (!DiscoverRigLayout(image_names, layout_options, layout, error)) {
+    *error = source + ": " + *error;
+    return false;
+  }
+  std::cout << RigLayoutTable(image_names, *layout) << std::endl;
+
+  std::vector<std::string> models;
+  if (!CameraModels(options.camera_model, layout->camera_names, &models,
+                    error)) {
+    return false;
+  }
+  const int num_cameras = static_cast<int>(layout->camera_names.size());
+  std::vector<std::pair<int, int>> camera_sizes(num_cameras, {0, 0});
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    const int c = layout->images[i].camera_index;
+    if (c < 0) continue;
+    if (camera_sizes[c].first == 0) {
+      camera_sizes[c] = image_sizes[i];
+    } else if (camera_sizes[c] != image_sizes[i]) {
+      *error = "the images of camera " + layout->camera_names[c] +
+               " have different sizes (" + image_names[i] + " is " +
+               std::to_string(image_sizes[i].first) + "x" +
+               std::to_string(image_sizes[i].second) +
+               "): one folder must hold the images of one camera";
+      return false;
+    }
+  }
+  for (int c = 0; c < num_cameras; ++c) {
+    RigCamera camera;
+    camera.name = layout->camera_names[c];
+    const auto [width, height] = camera_sizes[c];
+    // COLMAP's default initialization: focal 1.2 max(w, h), principal point
+    // at the image center. Only the principal point is used before the
+    // upgrade estimates the rest.
+    camera.camera.InitializeWithName(models[c], 1.2 * std::max(width, height),
+                                     width, height);
+    dataset->cameras.push_back(camera);
+  }
+  dataset->frameset_names = layout->frameset_names;
+  dataset->reference_camera = 0;
+  if (!options.reference_camera.empty()) {
+    const auto it =
+        std::find(layout->camera_names.begin(), layout->camera_names.end(),
+                  options.reference_camera);
+    if (it == layout->camera_names.end()) {
+      *error = "--RigCalibrator.reference_camera " + options.reference_camera +
+               " is not a camera of the rig";
+      return false;
+    }
+    dataset->reference_camera =
+        static_cast<int>(it - layout->camera_names.begin());
+  }
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    if (layout->images[i].camera_index < 0) continue;
+    RigImage image;
+    image.name = image_names[i];
+    image.camera_index = layout->images[i].camera_index;
+    image.frameset_index = layout->images[i].frameset_index;
+    dataset->images.push_back(image);
+  }
+  return true;
+}
+
+// The known* methods: intrinsics from --RigCalibrator.intrinsics_path, else
+// from the database cameras of the rig images (as set by
+// feature_extractor --ImageReader.camera_params).
+bool SetKnownIntrinsics(const CalibrateOptions& options,
+                        const std::vector<colmap::Camera>& database_cameras,
+                        RigDataset* dataset, std::string* error) {
+  std::vector<std::optional<colmap::Camera>> known(dataset->cameras.size());
+  if (!options.intrinsics_path.empty()) {
+    RigDescription rig;
+    if (!ReadRigReference(options.intrinsics_path, &rig, error)) return false;
+    for (size_t c = 0; c < dataset->cameras.size(); ++c) {
+      for (const RigDescriptionCamera& camera : rig.cameras) {
+        if (camera.name == dataset->cameras[c].name && camera.camera) {
+          known[c] = *camera.camera;
+        }
+      }
+    }
+  } else {
+    for (size_t c = 0; c < dataset->cameras.size(); ++c) {
+      if (c < database_cameras.size() &&
+          database_cameras[c].HasPriorFocalLength()) {
+        known[c] = database_cameras[c];
+      }
+    }
+  }
+  for (size_t c = 0; c < dataset->cameras.size(); ++c) {
+    RigCamera& camera = dataset->cameras[c];
+    if (!known[c]) {
+      *error = "method " + options.method + " needs the intrinsics of camera " +
+               camera.name +
+               ": give --RigCalibrator.intrinsics_path, or extract its "
+               "features with --ImageReader.camera_model and "
+               "--ImageReader.camera_params";
+      return false;
+    }
+    colmap::Camera intrinsics = *known[c];
+    if (intrinsics.Width() == 0) {
+      intrinsics.SetWidth(camera.camera.Width());
+      intrinsics.SetHeight(camera.camera.Height());
+    }
+    camera.camera = intrinsics;
+    camera.intrinsics_known = true;
+  }
+  return true;
+}
+
+// The image size of every rig image from its database camera (and the
+// camera, for the known* methods). Fails for a rig image missing from the
+// database and for one that is also a registered map image.
+bool ReadRigImageCameras(const CalibrateOptions& options,
+                         const DatabaseReader& database,
+                         const colmap::Reconstruction& map,
+                         const std::vector<std::string>& image_names,
+                         std::vector<std::pair<int, int>>* image_sizes,
+                         std::map<std::string, colmap::Camera>* cameras_by_name,
+                         std::string* error) {
+  std::vector<std::string> missing;
+  for (const std::string& name : image_names) {
+    const DatabaseImage* image = database.FindImageWithName(name);
+    if (image == nullptr) {
+      missing.push_back(name);
+      image_sizes->emplace_back(0, 0);
+      continue;
+    }
+    colmap::Camera camera;
+    if (!database.ReadCamera(image->camera_id, &camera, error)) return false;
+    image_sizes->emplace_back(static_cast<int>(camera.Width()),
+                              static_cast<int>(camera.Height()));
+    (*cameras_by_name)[name] = camera;
+  }
+  if (!missing.empty()) {
+    *error = std::to_string(missing.size()) + " of the " +
+             std::to_string(image_names.size()) + " images under " +
+             options.image_path + " are not in the database " +
+             options.database_path + " (e.g. " + missing.front() +
+             "): run colmap feature_extractor on the rig images into a copy "
+             "of the map's database first (scripts/calibrate_rig.sh does)";
+    return false;
+  }
+  for (const colmap::image_t image_id : map.RegImageIds()) {
+    const std::string& name = map.Image(image_id).Name();
+    if (std::binary_search(image_names.begin(), image_names.end(), name)) {
+      *error =
+          "image " + name +
+          " is both a rig image and a registered map image: keep the rig "
+          "images out of the map, or give --image_path the rig images only";
+      return false;
+    }
+  }
+  return true;
+}
+
+// The 2D-3D correspondences of every dataset image, by localizing it
+// against the map.
+bool LocalizeDatasetImages(const CalibrateOptions& options,
+                           const colmap::Reconstruction& map,
+                           const DatabaseReader& database, RigDataset* dataset,
+                           std::string* error) {
+  MapLocalizerOptions localizer_options;
+  if (!MakeLocalizerOptions(options, &localizer_options, error)) return false;
+  std::cout << "== Localization against the map (" << options.localization_mode
+            << ")" << std::endl;
+  colmap::Timer timer;
+  timer.Start();
+  const std::unique_ptr<MapLocalizer> localizer =
+      MapLocalizer::Create(localizer_options, map, &database, error);
+  if (localizer == nullptr) return false;
+  std::vector<std::string> names;
+  for (const RigImage& image : dataset->images) names.push_back(image.name);
+  std::vector<ImageLocalization> localizations;
+  if (!localizer->LocalizeImages(names, &localizations, error)) return false;
+  size_t num_correspondences = 0;
+  for (size_t i = 0; i < dataset->images.size(); ++i) {
+    dataset->images[i].correspondences =
+        std::move(localizations[i].correspondences);
+    num_correspondences += dataset->images[i].correspondences.size();
+  }
+  std::cout << "  " << num_correspondences << " 2D-3D correspondences for "
+            << dataset->images.size() << " images against "
+            << localizer->NumMapImages() << " map images and "
+            << localizer->NumMapPoints() << " map points in " << std::fixed
+            << std::setprecision(1) << timer.ElapsedSeconds() << " s"
+            << std::endl;
+  return true;
+}
+
+}  // namespace
+
+bool LoadFromDatabase(const CalibrateOptions& options,
+                      const colmap::Reconstruction& map, RigDataset* dataset,
+                      RigLayout* layout, std::string* error) {
+  std::vector<std::string> image_names;
+  if (!ListImages(options.image_path, &image_names, error)) return false;
+  DatabaseReader database;
+  if (!database.Open(options.database_path, error)) return false;
+  std::vector<std::pair<int, int>> image_sizes;
+  std::map<std::string, colmap::Camera> cameras_by_name;
+  if (!ReadRigImageCameras(options, database, map, image_names, &image_sizes,
+                           &cameras_by_name, error) ||
+      !MakeDataset(options,
+                   "the rig images under --image_path " + options.image_path,
+                   image_names, image_sizes, dataset, layout, error)) {
+    return false;
+  }
+  if (options.KnownIntrinsics()) {
+    std::vector<colmap::Camera> database_cameras(dataset->cameras.size());
+    for (const RigImage& image : dataset->images) {
+      database_cameras[image.camera_index] = cameras_by_name[image.name];
+    }
+    if (!SetKnownIntrinsics(options, database_cameras, dataset, error)) {
+      return false;
+    }
+  }
+  return LocalizeDatasetImages(options, map, database, dataset, error);
+}
+
+bool LoadFromCorrespondences(const CalibrateOptions& options,
+                             RigDataset* dataset, RigLayout* layout,
+                             std::string* error) {
+  std::vector<ImageCorrespondences> images;
+  if (!ReadCorrespondenceFile(options.correspondences_path, &images, error)) {
+    return false;
+  }
+  std::vector<std::string> image_names;
+  std::vector<std::pair<int, int>> image_sizes;
+  std::map<std::string, size_t> index_by_name;
+  for (size_t i = 0; i < images.size(); ++i) {
+    image_names.push_back(images[i].image_name);
+    image_sizes.emplace_back(images[i].width, images[i].height);
+    index_by_name[images[i].image_name] = i;
+  }
+  if (!MakeDataset(options,
+                   "the images of --correspondences_path " +
+                       options.correspondences_path,
+                   image_names, image_sizes, dataset, layout, error)) {
+    return false;
+  }
+  if (options.KnownIntrinsics()) {
+    if (!SetKnownIntrinsics(options, {}, dataset, error)) return false;
+  }
+  for (RigImage& image : dataset->images) {
+    image.correspondences =
+        std::move(images[index_by_name[image.name]].correspondences);
+  }
+  return true;
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,31 @@
+// The calibration problem of `rig_calibrator [calibrate]`: the rig layout
+// (cameras, framesets) of the rig images and their 2D-3D correspondences,
+// either localized against a COLMAP map (database + model) or read from a
+// correspondence file.
+#pragma once
+
+#include <colmap/base/reconstruction.h>
+
+#include <string>
+
+#include "colmap_ext/commands/calibrate_options.h"
+#include "colmap_ext/io/rig_layout.h"
+#include "src/calibration/rig_dataset.h"
+
+namespace rig_calibrator {
+
+// The images under --image_path, their cameras in --database_path and their
+// correspondences from localizing them against `map`. Prints the rig layout
+// and the localization's progress. False with *error (naming the file or
+// option) on failure.
+bool LoadFromDatabase(const CalibrateOptions& options,
+                      const colmap::Reconstruction& map, RigDataset* dataset,
+                      RigLayout* layout, std::string* error);
+
+// The images and correspondences of --correspondences_path. Prints the rig
+// layout.
+bool LoadFromCorrespondences(const CalibrateOptions& options,
+                             RigDataset* dataset, RigLayout* layout,
+                             std::string* error);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,37 @@
+# Sourced by the scripts, after `set -euo pipefail` and with `log_tag` set to
+# the script's name (the prefix of its messages): the repository, the build
+# folder and the rig_calibrator binary in it, and the helpers below.
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
+rig_calibrator="$build/rig_calibrator"
+
+# Prints "[log_tag] ERROR: message" and exits 1.
+die() { echo "[$log_tag] ERROR: $*" >&2; exit 1; }
+
+# Prints the header comment of the running script: its usage.
+usage() {
+  sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'
+}
+
+# run_step NAME COMMAND...: runs a step (dies if it fails) and records its
+# wall time in `timings`, the name padded to step_name_width characters.
+step_name_width=40
+timings=()
+run_step() {
+  local name="$1"
+  shift
+  local start=$SECONDS
+  echo
+  echo "[$log_tag] === $name"
+  "$@" || die "step '$name' failed"
+  timings+=("$(printf "%-${step_name_width}s %5d s" "$name" $((SECONDS - start)))")
+}
+
+# print_timings START: the recorded steps and the total since SECONDS was
+# START.
+print_timings() {
+  echo
+  echo "[$log_tag] === timings"
+  printf '  %s\n' "${timings[@]}"
+  printf "  %-${step_name_width}s %5d s\n" "total" $((SECONDS - $1))
+}
