@@ -54,8 +54,7 @@ TEST(Rigid3d, NearestRotationOfNoisyRotation) {
 TEST(Rigid3d, AngleAxisTranslationRoundTrip) {
   const Rigid3d pose = RandomTransform(7);
   const std::array<double, 6> parameters = ToAngleAxisTranslation(pose);
-  const Eigen::Vector3d angle_axis(parameters[0], parameters[1],
-                                   parameters[2]);
+  const Eigen::Vector3d angle_axis(parameters[0], parameters[1], parameters[2]);
   EXPECT_NEAR(angle_axis.norm(), Eigen::AngleAxisd(pose.rotation).angle(),
               1e-12);
   const Rigid3d back = FromAngleAxisTranslation(parameters);
