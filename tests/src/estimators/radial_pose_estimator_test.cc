@@ -42,6 +42,14 @@ struct SceneOptions {
   double planar_thickness = 1e-3;
 };
 
+SceneOptions NoisyScene(int num_points, double noise_px, double outlier_ratio) {
+  SceneOptions options;
+  options.num_points = num_points;
+  options.noise_px = noise_px;
+  options.outlier_ratio = outlier_ratio;
+  return options;
+}
+
 // A random camera (equidistant fisheye, f = 500 px, principal point at the
 // origin) seeing points 2-10 m away up to 60 degrees off axis (image radius
 // <= 524 px). Inliers get Gaussian noise; outliers a random pixel in the
@@ -134,10 +142,7 @@ Rigid3d ClosestTruth(const Scene& scene, const Rigid3d& estimate) {
 
 TEST(RadialPoseEstimator, ResidualsAreSquaredRadialErrors) {
   std::mt19937 rng(1);
-  SceneOptions options;
-  options.num_points = 200;
-  options.outlier_ratio = 0.3;
-  options.noise_px = 2;
+  SceneOptions options = NoisyScene(200, 2, 0.3);
   Scene scene = MakeScene(options, &rng);
   // Two points on the wrong half-line and one on the optical axis.
   scene.points2D[0] = -scene.points2D[0];
@@ -211,10 +216,7 @@ TEST(RadialPoseLocalEstimator, RecoversExactPose) {
 
 TEST(RadialPoseLocalEstimator, RobustToNoiseAndFewOutliers) {
   std::mt19937 rng(4);
-  SceneOptions options;
-  options.num_points = 200;
-  options.noise_px = 1;
-  options.outlier_ratio = 0.05;
+  SceneOptions options = NoisyScene(200, 1, 0.05);
   for (int k = 0; k < 10; ++k) {
     const Scene scene = MakeScene(options, &rng);
     RadialPoseLocalEstimator estimator;
@@ -319,10 +321,7 @@ void ExpectAccurate(const RobustResult& result, double max_rotation_error_deg,
 
 // 300 points, 0.5 px noise, 30% outliers, over 20 random scenes.
 TEST(EstimateRadialPose, NoiseAndOutliers) {
-  SceneOptions options;
-  options.num_points = 300;
-  options.noise_px = 0.5;
-  options.outlier_ratio = 0.3;
+  SceneOptions options = NoisyScene(300, 0.5, 0.3);
   ExpectAccurate(RunRobustEstimation(options, 20, 6), 0.05, 0.01);
 }
 
@@ -334,10 +333,7 @@ TEST(EstimateRadialPose, NoiseAndOutliers) {
 // estimate is checked against the optimum of the cost, with a loose bound
 // to the truth.
 TEST(EstimateRadialPose, NearPlanarNoiseAndOutliers) {
-  SceneOptions options;
-  options.num_points = 300;
-  options.noise_px = 0.5;
-  options.outlier_ratio = 0.3;
+  SceneOptions options = NoisyScene(300, 0.5, 0.3);
   options.planar = true;
   ExpectAccurate(RunRobustEstimation(options, 20, 7), 0.5, 0.06);
 }
@@ -478,10 +474,7 @@ TEST(RefineRadialPose, ConvergesFromPerturbedPoseAndKeepsTz) {
 // optimum on noisy data.
 TEST(RefineRadialPose, AgreesWithCeresOnRadialReprojectionCost) {
   std::mt19937 rng(14);
-  SceneOptions options;
-  options.num_points = 300;
-  options.noise_px = 1;
-  options.outlier_ratio = 0.1;
+  SceneOptions options = NoisyScene(300, 1, 0.1);
   for (int k = 0; k < 3; ++k) {
     const Scene scene = MakeScene(options, &rng);
     const std::vector<char> all(scene.points2D.size(), 1);

@@ -85,33 +85,31 @@ class Fingerprint {
   uint64_t hash_ = 0xcbf29ce484222325ull;
 };
 
+SyntheticRigOptions Case(RigPreset preset, int num_framesets,
+                         int points_per_image, unsigned int seed) {
+  SyntheticRigOptions options;
+  options.preset = preset;
+  options.num_framesets = num_framesets;
+  options.points_per_image = points_per_image;
+  options.seed = seed;
+  return options;
+}
+
 std::vector<SyntheticRigOptions> SyntheticCases() {
   std::vector<SyntheticRigOptions> cases;
   for (const RigPreset preset : AllRigPresets()) {
-    SyntheticRigOptions options;
-    options.preset = preset;
-    options.num_framesets = 8;
-    options.points_per_image = 60;
-    options.seed = 11;
-    cases.push_back(options);
+    cases.push_back(Case(preset, 8, 60, 11));
   }
-  SyntheticRigOptions varied;
-  varied.preset = RigPreset::kCarSurround4;
-  varied.num_framesets = 10;
-  varied.points_per_image = 80;
+  SyntheticRigOptions varied = Case(RigPreset::kCarSurround4, 10, 80, 3);
   varied.noise_px = 1.5;
   varied.outlier_ratio = 0.4;
   varied.missing_image_ratio = 0.25;
   varied.near_planar_ratio = 0.5;
   varied.track_ratio = 0.8;
   varied.feature_window = 0.4;
-  varied.seed = 3;
   cases.push_back(varied);
-  SyntheticRigOptions ring;
+  SyntheticRigOptions ring = Case(RigPreset::kRing5, 4, 40, 5);
   ring.ring_num_cameras = 12;
-  ring.num_framesets = 4;
-  ring.points_per_image = 40;
-  ring.seed = 5;
   cases.push_back(ring);
   return cases;
 }
@@ -129,8 +127,8 @@ uint64_t RenderedPlanFingerprint() {
   for (const SceneType scene : AllSceneTypes()) {
     RenderedDatasetOptions options;
     options.scene = scene;
-    options.preset =
-        scene == SceneType::kRoom ? RigPreset::kRing5 : RigPreset::kCarSurround4;
+    options.preset = scene == SceneType::kRoom ? RigPreset::kRing5
+                                               : RigPreset::kCarSurround4;
     options.num_map_images = 20;
     options.num_framesets = 6;
     options.seed = 9;
