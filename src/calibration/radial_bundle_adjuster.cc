@@ -12,7 +12,7 @@
 #include <sstream>
 #include <vector>
 
-#include "src/geometry/radial_cost_functions.h"
+#include "src/geometry/radial_rig_cost_function.h"
 #include "src/calibration/rig_initializer.h"
 
 namespace rig_calibrator {

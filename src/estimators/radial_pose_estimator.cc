@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 
+#include "src/geometry/point_normalization.h"
 #include "src/geometry/radial_error.h"
 #include "src/solvers/radial_pose_solver.h"
 
@@ -22,7 +23,7 @@ using Matrix5d = Eigen::Matrix<double, 5, 5>;
 using Vector5d = Eigen::Matrix<double, 5, 1>;
 
 // A radial pose in the normalized world frame X_n = (X - c) / s
-// (NormalizePoints): rotation and (tx, ty).
+// (CenterAndScalePoints): rotation and (tx, ty).
 struct RadialPose {
   Eigen::Matrix3d rotation;
   Eigen::Vector2d translation;
@@ -37,7 +38,8 @@ double CauchyLoss(double error_sq, double scale_sq) {
 // Radial error of one point for the Levenberg-Marquardt refinement, as the
 // signed scalar e = (a x_2 - b x_1) / |(a, b)| (|e| is the radial error) with
 // its derivatives by (a, b). On the wrong half-line or on the optical axis
-// the error is |x| with zero derivatives, as in RadialResidual.
+// the error is |x| with zero derivatives, as in RadialResidual
+// (radial_residual.h).
 struct PointError {
   double error;
   double d_a;
@@ -48,12 +50,11 @@ PointError ComputePointError(const Eigen::Vector3d& point_in_cam,
                              const Eigen::Vector2d& point2D) {
   const double a = point_in_cam.x();
   const double b = point_in_cam.y();
-  const double radial_norm_sq = a * a + b * b;
   if (!(a * point2D.x() + b * point2D.y() > 0) ||
-      !(radial_norm_sq > 1e-24 * point_in_cam.squaredNorm())) {
+      IsOnOpticalAxis(point_in_cam)) {
     return {point2D.norm(), 0, 0};
   }
-  const double inv_norm = 1 / std::sqrt(radial_norm_sq);
+  const double inv_norm = 1 / std::sqrt(a * a + b * b);
   const double error = (a * point2D.y() - b * point2D.x()) * inv_norm;
   // d/da [c / n] = x_2 / n - c a / n^3 = (x_2 - e a / n) / n, likewise for b.
   return {error, (point2D.y() - error * a * inv_norm) * inv_norm,
@@ -166,33 +167,6 @@ bool RadialPoseFromRows(const Vector8d& rows,
   return true;
 }
 
-// Centers and scales world points for conditioning: X_n = (X - c) / s with
-// s the RMS distance from the centroid c. A pose maps as R X + t =
-// s (R X_n + t_n), t_n = (t + R c) / s, and the positive factor s changes no
-// radial direction. False for coincident (spread at rounding level of the
-// coordinates) or non-finite points.
-bool NormalizePoints(const std::vector<Eigen::Vector3d>& points3D,
-                     std::vector<Eigen::Vector3d>* normalized,
-                     Eigen::Vector3d* centroid, double* scale) {
-  *centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& X : points3D) *centroid += X;
-  *centroid /= points3D.size();
-  double mean_sq_radius = 0;
-  for (const Eigen::Vector3d& X : points3D) {
-    mean_sq_radius += (X - *centroid).squaredNorm();
-  }
-  *scale = std::sqrt(mean_sq_radius / points3D.size());
-  if (!(*scale > 1e-12 * centroid->norm()) || !(*scale > 0) ||
-      !std::isfinite(*scale)) {
-    return false;
-  }
-  normalized->resize(points3D.size());
-  for (size_t i = 0; i < points3D.size(); ++i) {
-    (*normalized)[i] = (points3D[i] - *centroid) / *scale;
-  }
-  return true;
-}
-
 RadialPose ToNormalizedFrame(const Rigid3d& cam_from_world,
                              const Eigen::Vector3d& centroid, double scale) {
   RadialPose pose;
@@ -254,7 +228,8 @@ std::vector<Rigid3d> RadialPoseLocalEstimator::Estimate(
 
   Eigen::Vector3d centroid;
   double scale;
-  if (!NormalizePoints(points3D, &points3D_normalized_, &centroid, &scale)) {
+  if (!CenterAndScalePoints(points3D, &points3D_normalized_, &centroid,
+                            &scale)) {
     return {};
   }
 
@@ -344,8 +319,8 @@ bool RefineRadialPose(const RadialPoseEstimationOptions& options,
   std::vector<Eigen::Vector3d> normalized_points3D;
   Eigen::Vector3d centroid;
   double scale;
-  if (!NormalizePoints(inlier_points3D, &normalized_points3D, &centroid,
-                       &scale)) {
+  if (!CenterAndScalePoints(inlier_points3D, &normalized_points3D, &centroid,
+                            &scale)) {
     return false;
   }
   RadialPose pose = ToNormalizedFrame(*cam_from_world, centroid, scale);

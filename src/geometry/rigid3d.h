@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 
 namespace rig_calibrator {
 
@@ -53,6 +54,14 @@ double RotationDifferenceRad(const Eigen::Quaterniond& a,
 // The same in degrees.
 double RotationDifferenceDeg(const Eigen::Quaterniond& a,
                              const Eigen::Quaterniond& b);
+
+// Angle between two (not necessarily unit) vectors, atan2(|a x b|, a . b) in
+// [0, pi]: unlike acos of the normalized dot product it keeps full precision
+// near 0 and pi. Radians; 0 if either vector is zero.
+inline double AngleBetweenRad(const Eigen::Vector3d& a,
+                              const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
 
 // A pose as one Ceres parameter block: (angle-axis of the rotation,
 // translation), the minimal 6-vector that the bundle adjusters optimize.

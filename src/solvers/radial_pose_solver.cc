@@ -5,6 +5,9 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "src/geometry/point_normalization.h"
 
 namespace rig_calibrator {
 namespace {
@@ -253,17 +256,11 @@ void SolveRadialPose5(const std::vector<Eigen::Vector2d>& points2D,
   constexpr int kNumPoints = 5;
   if (points2D.size() != kNumPoints || points3D.size() != kNumPoints) return;
 
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& X : points3D) centroid += X;
-  centroid /= kNumPoints;
-  double mean_sq_radius = 0;
-  for (const Eigen::Vector3d& X : points3D) {
-    mean_sq_radius += (X - centroid).squaredNorm();
-  }
-  const double scale = std::sqrt(mean_sq_radius / kNumPoints);
-  // Coincident points (a spread at rounding level of the coordinates).
-  if (!(scale > 1e-12 * centroid.norm()) || !(scale > 0) ||
-      !std::isfinite(scale)) {
+  std::vector<Eigen::Vector3d> points3D_normalized;
+  Eigen::Vector3d centroid;
+  double scale;
+  if (!CenterAndScalePoints(points3D, &points3D_normalized, &centroid,
+                            &scale)) {
     return;
   }
 
@@ -275,7 +272,7 @@ void SolveRadialPose5(const std::vector<Eigen::Vector2d>& points2D,
     const double norm = points2D[i].norm();
     if (!(norm > 0) || !std::isfinite(norm)) return;
     x_normalized.col(i) = points2D[i] / norm;
-    X_normalized.col(i) = (points3D[i] - centroid) / scale;
+    X_normalized.col(i) = points3D_normalized[i];
     const double u = x_normalized(0, i);
     const double v = x_normalized(1, i);
     system_t.col(i) << -v * X_normalized.col(i), -v, u * X_normalized.col(i), u;

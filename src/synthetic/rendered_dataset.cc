@@ -1,26 +1,19 @@
 #include "src/synthetic/rendered_dataset.h"
 
 #include <colmap/base/camera_models.h>
+#include <colmap/util/math.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <random>
 
 namespace rig_calibrator {
 namespace {
 
-constexpr double kDegree = M_PI / 180.0;
 // Closest a camera center may come to a surface.
 constexpr double kMinClearance = 0.25;
 // The rig walks an ellipse this much smaller than the map camera's.
 constexpr double kRigWalkScale = 0.65;
-
-std::string Numbered(int index) {
-  char buffer[16];
-  std::snprintf(buffer, sizeof(buffer), "%06d", index);
-  return buffer;
-}
 
 Eigen::Vector3d PointOnWalk(const SceneWalk& walk, double scale, double phi,
                             double height) {
@@ -108,6 +101,99 @@ Rigid3d BodyFromRig(const std::vector<Rigid3d>& cam_from_rig) {
                  -(body_from_rig_rotation * mean_center));
 }
 
+// The map camera and its poses (plan->scene is set), drawing 4 phases.
+bool PlanMapSequence(const RenderedDatasetOptions& options,
+                     std::mt19937* random, RenderedDatasetPlan* plan,
+                     std::string* error) {
+  const SceneWalk& walk = plan->scene.walk();
+  const bool indoors = options.scene == SceneType::kRoom;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto phase = [&]() { return 2.0 * M_PI * unit(*random); };
+
+  plan->map_camera.SetCameraId(1);
+  plan->map_camera.SetModelIdFromName("PINHOLE");
+  plan->map_camera.SetWidth(options.map_width);
+  plan->map_camera.SetHeight(options.map_height);
+  plan->map_camera.SetParams({options.map_focal_length,
+                              options.map_focal_length, 0.5 * options.map_width,
+                              0.5 * options.map_height});
+
+  // The map camera: heading outward (phi) plus a slow swing, pitch and roll
+  // oscillations, indoors pitched more to cover floor and ceiling.
+  const double yaw_phase = phase();
+  const double pitch_phase = phase();
+  const double roll_phase = phase();
+  const double height_phase = phase();
+  const double mean_pitch =
+      indoors ? -colmap::DegToRad(3.0) : colmap::DegToRad(3.0);
+  const double pitch_swing =
+      indoors ? colmap::DegToRad(15.0) : colmap::DegToRad(8.0);
+  const Rigid3d body_from_map_camera = BodyFromForwardCamera();
+  const std::vector<double> map_angles =
+      EvenlySpacedAngles(walk, 1.0, options.num_map_images, 0.0);
+  for (int i = 0; i < options.num_map_images; ++i) {
+    const double phi = map_angles[i];
+    const Eigen::Vector3d position =
+        PointOnWalk(walk, 1.0, phi,
+                    walk.eye_height + 0.1 * std::sin(4.0 * phi + height_phase));
+    if (!plan->scene.IsFree(position, kMinClearance)) {
+      *error = "map camera " + std::to_string(i) + " would stand in a wall";
+      return false;
+    }
+    const Rigid3d world_from_body = WorldFromBody(
+        position,
+        phi + colmap::DegToRad(30.0) * std::sin(2.0 * phi + yaw_phase),
+        mean_pitch + pitch_swing * std::sin(5.0 * phi + pitch_phase),
+        colmap::DegToRad(4.0) * std::sin(7.0 * phi + roll_phase));
+    plan->map_image_names.push_back("map_" + FramesetName(i) + ".png");
+    plan->map_cam_from_world.push_back(
+        (world_from_body * body_from_map_camera).Inverse());
+  }
+
+  return true;
+}
+
+// The rig: the same loop as the map camera's, smaller, half a step out of
+// phase, with random heading swings up to 45 degrees and tilts up to 8
+// degrees; 4 draws per frameset.
+bool PlanRigSequence(const RenderedDatasetOptions& options,
+                     std::mt19937* random, RenderedDatasetPlan* plan,
+                     std::string* error) {
+  const SceneWalk& walk = plan->scene.walk();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  plan->rig = MakeRigPreset(options.preset);
+  const Rigid3d body_from_rig = BodyFromRig(plan->rig.cam_from_rig);
+  const double rig_height =
+      options.rig_height > 0 ? options.rig_height : walk.eye_height;
+  const std::vector<double> rig_angles =
+      EvenlySpacedAngles(walk, kRigWalkScale, options.num_framesets, 0.5);
+  for (int j = 0; j < options.num_framesets; ++j) {
+    const double phi = rig_angles[j];
+    const double yaw =
+        phi + colmap::DegToRad(45.0) * (2.0 * unit(*random) - 1.0);
+    const double pitch = colmap::DegToRad(8.0) * (2.0 * unit(*random) - 1.0);
+    const double roll = colmap::DegToRad(6.0) * (2.0 * unit(*random) - 1.0);
+    const double height = rig_height + 0.1 * (2.0 * unit(*random) - 1.0);
+    const Rigid3d world_from_body = WorldFromBody(
+        PointOnWalk(walk, kRigWalkScale, phi, height), yaw, pitch, roll);
+    const Rigid3d rig_from_world = (world_from_body * body_from_rig).Inverse();
+    for (size_t c = 0; c < plan->rig.cam_from_rig.size(); ++c) {
+      const Eigen::Vector3d center =
+          (plan->rig.cam_from_rig[c] * rig_from_world).Center();
+      if (!plan->scene.IsFree(center, kMinClearance)) {
+        *error = "rig camera " + plan->rig.camera_names[c] + " of frameset " +
+                 std::to_string(j) + " would stand in a wall: the " +
+                 RigPresetName(options.preset) + " rig does not fit the " +
+                 SceneTypeName(options.scene) + " scene";
+        return false;
+      }
+    }
+    plan->rig.rig_from_world.push_back(rig_from_world);
+    plan->frameset_names.push_back(FramesetName(j));
+  }
+  return true;
+}
+
 }  // namespace
 
 bool RenderedDatasetOptions::Check(std::string* error) const {
@@ -146,81 +232,10 @@ bool PlanRenderedDataset(const RenderedDatasetOptions& options,
   if (!options.Check(error)) return false;
   *plan = RenderedDatasetPlan();
   plan->scene = TexturedScene::Make(options.scene, options.seed);
-  const SceneWalk& walk = plan->scene.walk();
-  const bool indoors = options.scene == SceneType::kRoom;
+  // One random stream: the map sequence's draws, then the rig's.
   std::mt19937 random(options.seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto phase = [&]() { return 2.0 * M_PI * unit(random); };
-
-  plan->map_camera.SetCameraId(1);
-  plan->map_camera.SetModelIdFromName("PINHOLE");
-  plan->map_camera.SetWidth(options.map_width);
-  plan->map_camera.SetHeight(options.map_height);
-  plan->map_camera.SetParams({options.map_focal_length,
-                              options.map_focal_length, 0.5 * options.map_width,
-                              0.5 * options.map_height});
-
-  // The map camera: heading outward (phi) plus a slow swing, pitch and roll
-  // oscillations, indoors pitched more to cover floor and ceiling.
-  const double yaw_phase = phase();
-  const double pitch_phase = phase();
-  const double roll_phase = phase();
-  const double height_phase = phase();
-  const double mean_pitch = indoors ? -3.0 * kDegree : 3.0 * kDegree;
-  const double pitch_swing = indoors ? 15.0 * kDegree : 8.0 * kDegree;
-  const Rigid3d body_from_map_camera = BodyFromForwardCamera();
-  const std::vector<double> map_angles =
-      EvenlySpacedAngles(walk, 1.0, options.num_map_images, 0.0);
-  for (int i = 0; i < options.num_map_images; ++i) {
-    const double phi = map_angles[i];
-    const Eigen::Vector3d position =
-        PointOnWalk(walk, 1.0, phi,
-                    walk.eye_height + 0.1 * std::sin(4.0 * phi + height_phase));
-    if (!plan->scene.IsFree(position, kMinClearance)) {
-      *error = "map camera " + std::to_string(i) + " would stand in a wall";
-      return false;
-    }
-    const Rigid3d world_from_body = WorldFromBody(
-        position, phi + 30.0 * kDegree * std::sin(2.0 * phi + yaw_phase),
-        mean_pitch + pitch_swing * std::sin(5.0 * phi + pitch_phase),
-        4.0 * kDegree * std::sin(7.0 * phi + roll_phase));
-    plan->map_image_names.push_back("map_" + Numbered(i) + ".png");
-    plan->map_cam_from_world.push_back(
-        (world_from_body * body_from_map_camera).Inverse());
-  }
-
-  // The rig: the same loop, smaller, half a step out of phase, with random
-  // heading swings up to 45 degrees and tilts up to 8 degrees.
-  plan->rig = MakeRigPreset(options.preset);
-  const Rigid3d body_from_rig = BodyFromRig(plan->rig.cam_from_rig);
-  const double rig_height =
-      options.rig_height > 0 ? options.rig_height : walk.eye_height;
-  const std::vector<double> rig_angles =
-      EvenlySpacedAngles(walk, kRigWalkScale, options.num_framesets, 0.5);
-  for (int j = 0; j < options.num_framesets; ++j) {
-    const double phi = rig_angles[j];
-    const double yaw = phi + 45.0 * kDegree * (2.0 * unit(random) - 1.0);
-    const double pitch = 8.0 * kDegree * (2.0 * unit(random) - 1.0);
-    const double roll = 6.0 * kDegree * (2.0 * unit(random) - 1.0);
-    const double height = rig_height + 0.1 * (2.0 * unit(random) - 1.0);
-    const Rigid3d world_from_body = WorldFromBody(
-        PointOnWalk(walk, kRigWalkScale, phi, height), yaw, pitch, roll);
-    const Rigid3d rig_from_world = (world_from_body * body_from_rig).Inverse();
-    for (size_t c = 0; c < plan->rig.cam_from_rig.size(); ++c) {
-      const Eigen::Vector3d center =
-          (plan->rig.cam_from_rig[c] * rig_from_world).Center();
-      if (!plan->scene.IsFree(center, kMinClearance)) {
-        *error = "rig camera " + plan->rig.camera_names[c] + " of frameset " +
-                 std::to_string(j) + " would stand in a wall: the " +
-                 RigPresetName(options.preset) + " rig does not fit the " +
-                 SceneTypeName(options.scene) + " scene";
-        return false;
-      }
-    }
-    plan->rig.rig_from_world.push_back(rig_from_world);
-    plan->frameset_names.push_back(Numbered(j));
-  }
-  return true;
+  return PlanMapSequence(options, &random, plan, error) &&
+         PlanRigSequence(options, &random, plan, error);
 }
 
 }  // namespace rig_calibrator

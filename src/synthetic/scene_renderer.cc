@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "src/geometry/rigid3d.h"
+#include "src/synthetic/hash_random.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -26,17 +29,6 @@ bool UnitRay(const colmap::Camera& camera, const Eigen::Vector2d& image_point,
   return true;
 }
 
-double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-inline uint64_t Mix(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
 // A standard normal number determined by (seed, x, y, channel): Box-Muller
 // on two hashed uniforms, so the noise does not depend on thread scheduling.
 double GaussianNoise(uint64_t seed, int x, int y, int channel) {
@@ -45,8 +37,56 @@ double GaussianNoise(uint64_t seed, int x, int y, int channel) {
                                      static_cast<uint64_t>(channel)));
   const uint64_t h2 = Mix(h1);
   const double u1 = (static_cast<double>(h1 >> 11) + 1.0) * 0x1.0p-53;
-  const double u2 = static_cast<double>(h2 >> 11) * 0x1.0p-53;
+  const double u2 = ToUnit(h2);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+// Face index of the hit of each pixel's center ray (row-major), kSky for
+// rays that hit nothing, kNoRay for pixels without a ray; the hits in *hits.
+constexpr int kNoRay = -2;
+constexpr int kSky = -1;
+
+std::vector<int> IntersectCenterRays(
+    const TexturedScene& scene, const CameraRays& rays,
+    const Eigen::Matrix3d& world_from_cam_rotation,
+    const Eigen::Vector3d& center, std::vector<SceneHit>* hits) {
+  const int width = rays.width();
+  const int height = rays.height();
+  const size_t num_pixels = static_cast<size_t>(width) * height;
+  hits->assign(num_pixels, SceneHit());
+  std::vector<int> faces(num_pixels, kNoRay);
+#pragma omp parallel for schedule(dynamic)
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t pixel = static_cast<size_t>(y) * width + x;
+      const Eigen::Vector3f& camera_ray = rays.CenterRay(x, y);
+      if (camera_ray.isZero()) continue;
+      const Eigen::Vector3d direction =
+          world_from_cam_rotation * camera_ray.cast<double>();
+      faces[pixel] = scene.Intersect(center, direction, &(*hits)[pixel])
+                         ? (*hits)[pixel].face
+                         : kSky;
+    }
+  }
+  return faces;
+}
+
+// A bitmap from row-major 8-bit pixels, 3 channels for RGB, 1 for grey.
+colmap::Bitmap ToBitmap(const std::vector<uint8_t>& pixels, int width,
+                        int height, bool as_rgb) {
+  const int channels = as_rgb ? 3 : 1;
+  colmap::Bitmap bitmap;
+  bitmap.Allocate(width, height, as_rgb);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const uint8_t* p =
+          &pixels[(static_cast<size_t>(y) * width + x) * channels];
+      bitmap.SetPixel(x, y,
+                      as_rgb ? colmap::BitmapColor<uint8_t>(p[0], p[1], p[2])
+                             : colmap::BitmapColor<uint8_t>(p[0]));
+    }
+  }
+  return bitmap;
 }
 
 }  // namespace
@@ -123,7 +163,7 @@ CameraRays::CameraRays(const colmap::Camera& camera, int supersampling)
       if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
       const size_t neighbour = static_cast<size_t>(ny) * width_ + nx;
       if (center_rays_[neighbour].isZero()) continue;
-      angle += AngleBetween(center_rays[pixel], center_rays[neighbour]);
+      angle += AngleBetweenRad(center_rays[pixel], center_rays[neighbour]);
       ++count;
     }
     return count > 0 ? angle / count : 0.0;
@@ -163,8 +203,6 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
   // Grazing incidence stretches the footprint by 1 / cos; the cap keeps
   // far, grazing floors from blurring to a flat grey.
   constexpr double kMinCosine = 0.2;
-  constexpr int kNoRay = -2;
-  constexpr int kSky = -1;
 
   // The color seen along a camera-frame ray whose pixel spans `ray_angle`.
   auto shade = [&](const Eigen::Vector3d& direction, const SceneHit* hit,
@@ -183,22 +221,9 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
 
   // Pass 1: what the center ray of every pixel hits.
   const size_t num_pixels = static_cast<size_t>(width) * height;
-  std::vector<SceneHit> center_hits(num_pixels);
-  std::vector<int> center_faces(num_pixels, kNoRay);
-#pragma omp parallel for schedule(dynamic)
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const size_t pixel = static_cast<size_t>(y) * width + x;
-      const Eigen::Vector3f& camera_ray = rays.CenterRay(x, y);
-      if (camera_ray.isZero()) continue;
-      const Eigen::Vector3d direction =
-          world_from_cam_rotation * camera_ray.cast<double>();
-      center_faces[pixel] =
-          scene.Intersect(center, direction, &center_hits[pixel])
-              ? center_hits[pixel].face
-              : kSky;
-    }
-  }
+  std::vector<SceneHit> center_hits;
+  const std::vector<int> center_faces = IntersectCenterRays(
+      scene, rays, world_from_cam_rotation, center, &center_hits);
 
   // Pass 2: one pre-filtered sample inside a face, supersampling where the
   // surface changes.
@@ -244,18 +269,7 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
     }
   }
 
-  bitmap.Allocate(width, height, options.as_rgb);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const uint8_t* p =
-          &pixels[(static_cast<size_t>(y) * width + x) * channels];
-      bitmap.SetPixel(x, y,
-                      options.as_rgb
-                          ? colmap::BitmapColor<uint8_t>(p[0], p[1], p[2])
-                          : colmap::BitmapColor<uint8_t>(p[0]));
-    }
-  }
-  return bitmap;
+  return ToBitmap(pixels, width, height, options.as_rgb);
 }
 
 colmap::Bitmap RenderImage(const TexturedScene& scene,

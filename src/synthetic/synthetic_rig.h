@@ -110,6 +110,10 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options);
 SyntheticRig SelectFramesets(const SyntheticRig& rig,
                              const std::vector<int>& framesets);
 
+// "000012": the name of frameset 12, zero-padded to 6 digits (also the
+// number in other numbered file names, e.g. of rendered map images).
+std::string FramesetName(int frameset);
+
 // Gives every dataset camera its true intrinsics, flagged as known (the
 // `known*` methods).
 void SetKnownIntrinsics(SyntheticRig* rig);

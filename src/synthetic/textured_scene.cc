@@ -6,28 +6,17 @@
 #include <cstdint>
 #include <limits>
 
+#include "src/synthetic/enum_names.h"
+#include "src/synthetic/hash_random.h"
+
 namespace rig_calibrator {
 namespace {
-
-// splitmix64's finalizer: a bijective 64-bit mix with full avalanche, so
-// hashes of neighbouring lattice cells are unrelated.
-inline uint64_t Mix(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 // One Mix of the cell coordinates multiplied by large odd constants: cheap
 // (it runs once per lattice corner) and unrelated across neighbouring cells.
 inline uint64_t HashCell(uint64_t seed, int64_t i, int64_t j) {
   return Mix(seed ^ (static_cast<uint64_t>(i) * 0x9e3779b97f4a7c15ull) ^
              (static_cast<uint64_t>(j) * 0xc2b2ae3d27d4eb4full));
-}
-
-// Uniform in [0, 1) from the top 53 bits.
-inline double ToUnit(uint64_t hash) {
-  return static_cast<double>(hash >> 11) * 0x1.0p-53;
 }
 
 // Successive independent uniforms from one cell hash.
@@ -238,6 +227,16 @@ void AddTable(double x0, double y0, double x1, double y1, double height,
   }
 }
 
+// A scene whose walk ellipse is centered on the origin.
+TexturedScene SceneWithWalk(std::vector<SceneBox> boxes,
+                            const Eigen::Vector2d& walk_radii,
+                            double eye_height, unsigned int seed) {
+  SceneWalk walk;
+  walk.radii = walk_radii;
+  walk.eye_height = eye_height;
+  return TexturedScene(std::move(boxes), walk, seed);
+}
+
 TexturedScene MakeRoom(unsigned int seed) {
   std::vector<SceneBox> boxes;
   SceneBox room = Solid(-4, -3, 0, 4, 3, 3);
@@ -257,10 +256,7 @@ TexturedScene MakeRoom(unsigned int seed) {
   boxes.push_back(Solid(-3.5, 2.0, 0, -2.7, 2.8, 0.9));
   boxes.push_back(Solid(-3.9, -2.9, 0, -3.0, -2.1, 1.1));
   AddTable(2.6, 1.2, 3.6, 2.4, 0.78, &boxes);
-  SceneWalk walk;
-  walk.radii = Eigen::Vector2d(2.3, 1.4);
-  walk.eye_height = 1.5;
-  return TexturedScene(std::move(boxes), walk, seed);
+  return SceneWithWalk(std::move(boxes), Eigen::Vector2d(2.3, 1.4), 1.5, seed);
 }
 
 TexturedScene MakeCourtyard(unsigned int seed) {
@@ -296,10 +292,7 @@ TexturedScene MakeCourtyard(unsigned int seed) {
       boxes.push_back(Solid(x - 0.08, y - 0.08, 0, x + 0.08, y + 0.08, 3));
     }
   }
-  SceneWalk walk;
-  walk.radii = Eigen::Vector2d(6.5, 6.0);
-  walk.eye_height = 1.6;
-  return TexturedScene(std::move(boxes), walk, seed);
+  return SceneWithWalk(std::move(boxes), Eigen::Vector2d(6.5, 6.0), 1.6, seed);
 }
 
 TexturedScene MakeStreet(unsigned int seed) {
@@ -339,39 +332,25 @@ TexturedScene MakeStreet(unsigned int seed) {
           Solid(x - 0.1, side * 5.6 - 0.1, 0, x + 0.1, side * 5.6 + 0.1, 5));
     }
   }
-  SceneWalk walk;
-  walk.radii = Eigen::Vector2d(12, 1.8);
-  walk.eye_height = 1.6;
-  return TexturedScene(std::move(boxes), walk, seed);
+  return SceneWithWalk(std::move(boxes), Eigen::Vector2d(12, 1.8), 1.6, seed);
 }
+
+constexpr EnumNameTable<SceneType, 3> kSceneTypeNames = {
+    {{SceneType::kRoom, "room"},
+     {SceneType::kCourtyard, "courtyard"},
+     {SceneType::kStreet, "street"}}};
 
 }  // namespace
 
 bool SceneTypeFromName(const std::string& name, SceneType* type) {
-  for (const SceneType candidate : AllSceneTypes()) {
-    if (SceneTypeName(candidate) == name) {
-      *type = candidate;
-      return true;
-    }
-  }
-  return false;
+  return EnumFromName(kSceneTypeNames, name, type);
 }
 
 std::string SceneTypeName(SceneType type) {
-  switch (type) {
-    case SceneType::kRoom:
-      return "room";
-    case SceneType::kCourtyard:
-      return "courtyard";
-    case SceneType::kStreet:
-      return "street";
-  }
-  return "";
+  return EnumName(kSceneTypeNames, type);
 }
 
-std::vector<SceneType> AllSceneTypes() {
-  return {SceneType::kRoom, SceneType::kCourtyard, SceneType::kStreet};
-}
+std::vector<SceneType> AllSceneTypes() { return EnumValues(kSceneTypeNames); }
 
 TexturedScene::TexturedScene(std::vector<SceneBox> boxes, const SceneWalk& walk,
                              unsigned int seed)

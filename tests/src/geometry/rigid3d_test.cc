@@ -51,11 +51,30 @@ TEST(Rigid3d, NearestRotationOfNoisyRotation) {
   EXPECT_NEAR(NearestRotation(reflection).determinant(), 1.0, 1e-12);
 }
 
+// Known angles, independent of the vectors' lengths, and full precision near
+// 0 and pi, where acos of the normalized dot product loses half the digits
+// (acos(1 - 5e-21) rounds to 0).
+TEST(AngleBetweenRad, KnownAnglesAtFullPrecision) {
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
+  EXPECT_NEAR(AngleBetweenRad(x, Eigen::Vector3d(1, 1, 0)), M_PI / 4, 1e-15);
+  EXPECT_NEAR(AngleBetweenRad(3 * x, Eigen::Vector3d(0, 0, 0.2)), M_PI / 2,
+              1e-15);
+  EXPECT_NEAR(AngleBetweenRad(Eigen::Vector3d(1e-3, 1e-3, 0), 1e3 * x),
+              M_PI / 4, 1e-15);
+  for (const double angle : {1e-10, 1e-6, 0.3}) {
+    const Eigen::Vector3d y(std::cos(angle), std::sin(angle), 0);
+    EXPECT_NEAR(AngleBetweenRad(x, y), angle, 1e-15 * angle) << angle;
+    EXPECT_NEAR(AngleBetweenRad(x, -y), M_PI - angle, 1e-15) << angle;
+  }
+  EXPECT_EQ(AngleBetweenRad(x, x), 0);
+  EXPECT_EQ(AngleBetweenRad(x, -x), M_PI);
+  EXPECT_EQ(AngleBetweenRad(x, Eigen::Vector3d::Zero()), 0);
+}
+
 TEST(Rigid3d, AngleAxisTranslationRoundTrip) {
   const Rigid3d pose = RandomTransform(7);
   const std::array<double, 6> parameters = ToAngleAxisTranslation(pose);
-  const Eigen::Vector3d angle_axis(parameters[0], parameters[1],
-                                   parameters[2]);
+  const Eigen::Vector3d angle_axis(parameters[0], parameters[1], parameters[2]);
   EXPECT_NEAR(angle_axis.norm(), Eigen::AngleAxisd(pose.rotation).angle(),
               1e-12);
   const Rigid3d back = FromAngleAxisTranslation(parameters);

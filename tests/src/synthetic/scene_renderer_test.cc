@@ -94,17 +94,6 @@ double NormalizedCrossCorrelation(const std::vector<double>& a,
   return ab / std::sqrt(aa * bb);
 }
 
-TEST(TexturedScene, SceneNamesRoundTrip) {
-  for (const SceneType type : AllSceneTypes()) {
-    SceneType parsed = SceneType::kStreet;
-    ASSERT_TRUE(SceneTypeFromName(SceneTypeName(type), &parsed));
-    EXPECT_EQ(parsed, type);
-  }
-  SceneType parsed = SceneType::kCourtyard;
-  EXPECT_FALSE(SceneTypeFromName("garden", &parsed));
-  EXPECT_EQ(parsed, SceneType::kCourtyard);
-}
-
 TEST(TexturedScene, RaysHitTheRightFaces) {
   const TexturedScene room = TexturedScene::Make(SceneType::kRoom, 0);
   SceneHit hit;

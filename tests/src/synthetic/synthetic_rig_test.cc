@@ -38,19 +38,6 @@ SyntheticRigOptions SmallOptions(RigPreset preset) {
   return options;
 }
 
-TEST(SyntheticRig, PresetNamesRoundTrip) {
-  for (const RigPreset preset : AllRigPresets()) {
-    RigPreset parsed = RigPreset::kStereoPair;
-    ASSERT_TRUE(RigPresetFromName(RigPresetName(preset), &parsed));
-    EXPECT_EQ(parsed, preset);
-  }
-  RigPreset parsed = RigPreset::kRing5;
-  EXPECT_TRUE(RigPresetFromName("fisheye_helmet5", &parsed));
-  EXPECT_EQ(parsed, RigPreset::kFisheyeHelmet5);
-  EXPECT_FALSE(RigPresetFromName("ring6", &parsed));
-  EXPECT_EQ(parsed, RigPreset::kFisheyeHelmet5);
-}
-
 TEST(SyntheticRig, PresetsMatchTheirDescription) {
   const std::map<RigPreset, std::vector<std::string>> models = {
       {RigPreset::kRing5, {"OPENCV", "OPENCV", "OPENCV", "OPENCV", "OPENCV"}},

@@ -1,9 +1,14 @@
-#include "src/geometry/radial_cost_functions.h"
+#include "src/geometry/radial_rig_cost_function.h"
 
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/rotation.h>
 #include <gtest/gtest.h>
 
 #include <array>
 #include <random>
+#include <string>
+
+#include "src/geometry/radial_residual.h"
 
 namespace rig_calibrator {
 namespace {
@@ -60,13 +65,29 @@ void ExpectNear(const std::array<double, N>& actual,
   }
 }
 
+// The camera-frame point of the cost function's chain, as RadialRigResidual
+// computes it.
+Eigen::Vector3d PointInCamera(const std::array<double, 6>& cam_from_rig,
+                              const std::array<double, 6>& rig_from_world,
+                              const Eigen::Vector3d& point3D) {
+  double point_in_rig[3], point_in_cam[3];
+  ceres::AngleAxisRotatePoint(rig_from_world.data(), point3D.data(),
+                              point_in_rig);
+  for (int r = 0; r < 3; ++r) point_in_rig[r] += rig_from_world[3 + r];
+  ceres::AngleAxisRotatePoint(cam_from_rig.data(), point_in_rig, point_in_cam);
+  for (int r = 0; r < 3; ++r) point_in_cam[r] += cam_from_rig[3 + r];
+  return Eigen::Vector3d(point_in_cam[0], point_in_cam[1], point_in_cam[2]);
+}
+
 // Residual and every Jacobian agree with automatic differentiation on
-// random poses, including zero and tiny rotations, points on the wrong
-// half-line (alpha <= 0) and on the optical axis.
+// random poses, including zero and tiny rotations, image points at the
+// principal point, points on the wrong half-line (alpha <= 0) and on the
+// optical axis.
 TEST(RadialRigCostFunction, MatchesAutomaticDifferentiation) {
   std::mt19937 random(5);
   std::uniform_real_distribution<double> unit(-1, 1);
   int num_wrong_half_line = 0;
+  int num_on_axis = 0;
   for (int trial = 0; trial < 200; ++trial) {
     std::array<double, 6> cam_from_rig, rig_from_world;
     for (int k = 0; k < 6; ++k) {
@@ -85,6 +106,15 @@ TEST(RadialRigCostFunction, MatchesAutomaticDifferentiation) {
     Eigen::Vector2d point2D(320 + 300 * unit(random), 240 + 200 * unit(random));
     if (trial % 10 == 3) {
       point2D = Eigen::Vector2d(principal_point[0], principal_point[1]);
+    } else if (trial % 10 == 4) {
+      // Move the camera so that the point lands on its optical axis (up to
+      // rounding, far below the 1e-12 rad of IsOnOpticalAxis).
+      const Eigen::Vector3d point_in_cam =
+          PointInCamera(cam_from_rig, rig_from_world, point3D);
+      cam_from_rig[3] -= point_in_cam.x();
+      cam_from_rig[4] -= point_in_cam.y();
+      ASSERT_TRUE(IsOnOpticalAxis(
+          PointInCamera(cam_from_rig, rig_from_world, point3D).data()));
     }
     const RadialRigCostFunction analytic(point2D, point3D);
     ceres::AutoDiffCostFunction<RadialRigResidual, 2, 6, 6, 2> automatic(
@@ -101,13 +131,25 @@ TEST(RadialRigCostFunction, MatchesAutomaticDifferentiation) {
                "d/rig_from_world");
     ExpectNear(actual.jacobian_principal_point,
                expected.jacobian_principal_point, 1e-12, "d/principal point");
-    num_wrong_half_line +=
+    const bool residual_is_x_minus_c =
         actual.residual[0] == point2D.x() - principal_point[0] &&
         actual.residual[1] == point2D.y() - principal_point[1];
+    if (trial % 10 == 4) {
+      // On the axis: e = x - c, no pull on either pose, de/dc = -I.
+      EXPECT_TRUE(residual_is_x_minus_c);
+      for (const double value : actual.jacobian_cam) EXPECT_EQ(value, 0);
+      for (const double value : actual.jacobian_rig) EXPECT_EQ(value, 0);
+      EXPECT_EQ(actual.jacobian_principal_point[0], -1);
+      EXPECT_EQ(actual.jacobian_principal_point[3], -1);
+      ++num_on_axis;
+    } else if (trial % 10 != 3) {
+      num_wrong_half_line += residual_is_x_minus_c;
+    }
   }
-  // Both branches of RadialResidual were exercised.
+  // Every branch of RadialResidual was exercised.
+  EXPECT_EQ(num_on_axis, 20);
   EXPECT_GT(num_wrong_half_line, 20);
-  EXPECT_LT(num_wrong_half_line, 180);
+  EXPECT_LT(num_wrong_half_line, 140);
 
   // Without Jacobians: the residual only.
   const RadialRigCostFunction cost(Eigen::Vector2d(400, 300),

@@ -1,16 +1,14 @@
-#include "src/geometry/radial_cost_functions.h"
+#include "src/geometry/radial_rig_cost_function.h"
+
+#include <colmap/base/pose.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "src/geometry/radial_residual.h"
+
 namespace rig_calibrator {
 namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d skew;
-  skew << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return skew;
-}
 
 // R(w) = exp([w]x) and the right Jacobian of SO(3),
 //   J_r(w) = I - (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2, t = |w|,
@@ -20,7 +18,7 @@ void RotationAndRightJacobian(const double* angle_axis,
                               Eigen::Matrix3d* right_jacobian) {
   const Eigen::Map<const Eigen::Vector3d> w(angle_axis);
   const double theta_sq = w.squaredNorm();
-  const Eigen::Matrix3d skew = Skew(w);
+  const Eigen::Matrix3d skew = colmap::CrossProductMatrix(w);
   if (theta_sq < 1e-16) {
     *rotation = Eigen::Matrix3d::Identity() + skew;
     if (right_jacobian != nullptr) {
@@ -36,6 +34,21 @@ void RotationAndRightJacobian(const double* angle_axis,
         Eigen::Matrix3d::Identity() - (1 - std::cos(theta)) / theta_sq * skew +
         (theta - std::sin(theta)) / (theta_sq * theta) * skew * skew;
   }
+}
+
+// The 2x6 Jacobian of e by a pose block (w, t) that maps v to R(w) v + t,
+// given d_out = de/d(R(w) v + t):
+//   de/dw = -d_out R(w) [v]x J_r(w),  de/dt = d_out.
+void WritePoseJacobian(const Eigen::Matrix<double, 2, 3>& d_out,
+                       const Eigen::Matrix3d& rotation,
+                       const Eigen::Vector3d& point,
+                       const Eigen::Matrix3d& right_jacobian,
+                       double* jacobian_row_major) {
+  Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
+      jacobian_row_major);
+  jacobian.leftCols<3>() =
+      -d_out * rotation * colmap::CrossProductMatrix(point) * right_jacobian;
+  jacobian.rightCols<3>() = d_out;
 }
 
 }  // namespace
@@ -66,9 +79,8 @@ bool RadialRigCostFunction::Evaluate(double const* const* parameters,
   // de/d(p0, p1) and de/d(x - c), as in RadialResidual's cases.
   Eigen::Matrix2d d_point = Eigen::Matrix2d::Zero();
   Eigen::Matrix2d d_centered = Eigen::Matrix2d::Identity();
-  const double radial_norm_sq = point_in_cam.head<2>().squaredNorm();
-  if (radial_norm_sq >= 1e-20) {
-    const double radial_norm = std::sqrt(radial_norm_sq);
+  if (!IsOnOpticalAxis(point_in_cam)) {
+    const double radial_norm = point_in_cam.head<2>().norm();
     const Eigen::Vector2d z = point_in_cam.head<2>() / radial_norm;
     const double alpha = z.dot(centered);
     if (alpha > 0) {
@@ -84,19 +96,12 @@ bool RadialRigCostFunction::Evaluate(double const* const* parameters,
   Eigen::Matrix<double, 2, 3> d_cam = Eigen::Matrix<double, 2, 3>::Zero();
   d_cam.leftCols<2>() = d_point;
   if (jacobians[0] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
-        jacobians[0]);
-    jacobian.leftCols<3>() =
-        -d_cam * cam_rotation * Skew(point_in_rig) * cam_jacobian;
-    jacobian.rightCols<3>() = d_cam;
+    WritePoseJacobian(d_cam, cam_rotation, point_in_rig, cam_jacobian,
+                      jacobians[0]);
   }
   if (jacobians[1] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
-        jacobians[1]);
-    const Eigen::Matrix<double, 2, 3> d_rig = d_cam * cam_rotation;
-    jacobian.leftCols<3>() =
-        -d_rig * rig_rotation * Skew(point3D_) * rig_jacobian;
-    jacobian.rightCols<3>() = d_rig;
+    WritePoseJacobian(d_cam * cam_rotation, rig_rotation, point3D_,
+                      rig_jacobian, jacobians[1]);
   }
   if (jacobians[2] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 2, Eigen::RowMajor>> jacobian(
