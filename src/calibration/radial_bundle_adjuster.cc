@@ -12,8 +12,8 @@
 #include <sstream>
 #include <vector>
 
+#include "src/calibration/principal_axes.h"
 #include "src/geometry/radial_cost_functions.h"
-#include "src/calibration/rig_initializer.h"
 
 namespace rig_calibrator {
 namespace {
