@@ -34,7 +34,7 @@ std::map<std::pair<int, int>, std::vector<double>> AxisAnglesOfCameraPairs(
         const double cosine =
             std::clamp(axes[a].second.dot(axes[b].second), -1.0, 1.0);
         angles_of_pair[std::minmax(axes[a].first, axes[b].first)].push_back(
-            std::acos(cosine) * 180.0 / M_PI);
+            colmap::RadToDeg(std::acos(cosine)));
       }
     }
   }
@@ -63,7 +63,7 @@ double SmallestAxisEigenvalue(const std::vector<Eigen::Vector3d>& axes) {
 }
 
 double AxisEigenvalueOfAngle(double min_angle_deg) {
-  return 1.0 - std::cos(min_angle_deg * M_PI / 180.0);
+  return 1.0 - std::cos(colmap::DegToRad(min_angle_deg));
 }
 
 bool AxesDetermineTranslation(const std::vector<Eigen::Vector3d>& axes,
@@ -93,9 +93,7 @@ bool PrincipalAxesAreParallel(const RigDataset& dataset,
   std::pair<int, int> widest_pair;
   int widest_count = 0;
   for (auto& [pair, angles] : angles_of_pair) {
-    std::nth_element(angles.begin(), angles.begin() + angles.size() / 2,
-                     angles.end());
-    const double median = angles[angles.size() / 2];
+    const double median = colmap::Median(angles);
     if (median > widest_angle) {
       widest_angle = median;
       widest_pair = pair;

@@ -264,7 +264,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   const int num_framesets = dataset.frameset_names.size();
   const int reference = dataset.reference_camera;
   const double min_axis_eigenvalue =
-      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
+      AxisEigenvalueOfAngle(options.min_principal_axis_angle_deg);
 
   // Inlier correspondences of images of calibrated cameras in posed
   // framesets that their observations determine.

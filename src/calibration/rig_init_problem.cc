@@ -1,5 +1,6 @@
 #include "src/calibration/rig_init_problem.h"
 
+#include <colmap/util/math.h>
 #include <colmap/util/threading.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "src/calibration/principal_axes.h"
 #include "src/calibration/rig_init_scoring.h"
 
 namespace rig_calibrator {
@@ -128,9 +130,9 @@ std::string BuildProblem(const RigInitializerOptions& options,
   problem->reference_camera = dataset.reference_camera;
   problem->num_rows = options.radial ? 2 : 3;
   problem->min_axis_eigenvalue =
-      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
+      AxisEigenvalueOfAngle(options.min_principal_axis_angle_deg);
   problem->max_rotation_deviation =
-      options.max_rotation_deviation_deg * M_PI / 180.0;
+      colmap::DegToRad(options.max_rotation_deviation_deg);
   problem->num_threads = colmap::GetEffectiveNumThreads(options.num_threads);
   problem->images_of_frameset.assign(problem->num_framesets, {});
   problem->images_of_camera.assign(problem->num_cameras, {});

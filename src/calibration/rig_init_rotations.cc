@@ -36,7 +36,7 @@ std::optional<RotationEstimate> ConsensusRotation(
     int support = 0;
     double angle_sum = 0;
     for (const Eigen::Quaterniond& other : candidates) {
-      const double angle = AngleRad(candidates[m], other);
+      const double angle = RotationDifferenceRad(candidates[m], other);
       if (angle < max_angle) {
         ++support;
         angle_sum += angle;
@@ -51,7 +51,7 @@ std::optional<RotationEstimate> ConsensusRotation(
   }
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
   for (const Eigen::Quaterniond& other : candidates) {
-    if (AngleRad(candidates[best], other) < max_angle) {
+    if (RotationDifferenceRad(candidates[best], other) < max_angle) {
       sum += other.toRotationMatrix();
     }
   }

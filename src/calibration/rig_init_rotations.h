@@ -12,8 +12,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <algorithm>
-#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -27,11 +25,6 @@ struct Rotations {
   std::vector<std::optional<Eigen::Quaterniond>> cam_from_rig;
   std::vector<std::optional<Eigen::Quaterniond>> rig_from_world;
 };
-
-inline double AngleRad(const Eigen::Quaterniond& a,
-                       const Eigen::Quaterniond& b) {
-  return 2 * std::acos(std::min(1.0, std::abs(a.dot(b))));
-}
 
 // The greedy back-and-forth assignment of one RANSAC trial. The seed
 // frameset (>= 2 localized images) places its cameras relative to a base

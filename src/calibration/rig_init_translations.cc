@@ -1,7 +1,8 @@
 #include "src/calibration/rig_init_translations.h"
 
+#include <colmap/util/math.h>
+
 #include <Eigen/Cholesky>
-#include <algorithm>
 
 namespace rig_calibrator {
 namespace rig_init {
@@ -116,11 +117,8 @@ bool UpdateWeights(const InitProblem& problem, const DeterminedParts& parts,
     residuals[k] = difference.norm();
     used_residuals.push_back(residuals[k]);
   }
-  std::nth_element(used_residuals.begin(),
-                   used_residuals.begin() + used_residuals.size() / 2,
-                   used_residuals.end());
-  const double scale = kTranslationCauchyScale * 1.4826 *
-                       used_residuals[used_residuals.size() / 2];
+  const double scale =
+      kTranslationCauchyScale * 1.4826 * colmap::Median(used_residuals);
   if (!(scale > 0)) return false;
   for (size_t k = 0; k < problem.images.size(); ++k) {
     const double ratio = residuals[k] / scale;

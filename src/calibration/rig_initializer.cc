@@ -48,9 +48,9 @@ Hypothesis MakeHypothesis(const InitProblem& problem, int seed_frameset) {
     usable[k] =
         rotations.cam_from_rig[image.camera] &&
         rotations.rig_from_world[image.frameset] &&
-        rig_init::AngleRad(*rotations.cam_from_rig[image.camera] *
-                               *rotations.rig_from_world[image.frameset],
-                           image.cam_from_world.rotation) <
+        RotationDifferenceRad(*rotations.cam_from_rig[image.camera] *
+                                  *rotations.rig_from_world[image.frameset],
+                              image.cam_from_world.rotation) <
             problem.max_rotation_deviation;
   }
   Hypothesis hypothesis =
