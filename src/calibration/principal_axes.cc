@@ -31,10 +31,8 @@ std::map<std::pair<int, int>, std::vector<double>> AxisAnglesOfCameraPairs(
     for (size_t a = 0; a < axes.size(); ++a) {
       for (size_t b = a + 1; b < axes.size(); ++b) {
         if (axes[a].first == axes[b].first) continue;
-        const double cosine =
-            std::clamp(axes[a].second.dot(axes[b].second), -1.0, 1.0);
         angles_of_pair[std::minmax(axes[a].first, axes[b].first)].push_back(
-            colmap::RadToDeg(std::acos(cosine)));
+            AxisAngleFromParallelDeg(axes[a].second, axes[b].second));
       }
     }
   }
@@ -103,12 +101,12 @@ bool PrincipalAxesAreParallel(const RigDataset& dataset,
   const bool parallel = widest_angle <= max_angle_deg;
   if (parallel) {
     message << "all principal axes are within " << max_angle_deg
-            << " degrees of parallel";
+            << " degrees of parallel or anti-parallel";
   } else {
     message << "the principal axes are not parallel";
   }
-  message << " (largest median angle " << widest_angle << " degrees, between "
-          << camera_name(widest_pair.first) << " and "
+  message << " (largest median angle from parallel " << widest_angle
+          << " degrees, between " << camera_name(widest_pair.first) << " and "
           << camera_name(widest_pair.second) << " over " << widest_count
           << " framesets)";
   if (explanation) *explanation = message.str();

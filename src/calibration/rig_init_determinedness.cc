@@ -24,17 +24,15 @@ bool FramesetDetermined(
                          .transpose());
     }
   }
-  return problem.num_rows == 2
-             ? axes.size() >= 2 &&
-                   SmallestAxisEigenvalue(axes) >= problem.min_axis_eigenvalue
-             : !axes.empty();
+  return problem.num_rows == 2 ? AxesDetermineTranslation(axes) : !axes.empty();
 }
 
 // Whether the images of `parts` determine all camera translations relative
 // to the anchor: no eigenvalue of the unweighted reduced matrix (gauge
-// fixed) below min_axis_eigenvalue / 2. The matrix is dimensionless; one
-// frameset with two cameras at the minimum angle contributes about
-// min_axis_eigenvalue.
+// fixed) below half the determinedness threshold of one frameset,
+// AxisEigenvalueOfAngle(kMinDeterminingAxisAngleDeg) / 2. The matrix is
+// dimensionless; one frameset with two cameras at that angle contributes
+// about the threshold.
 bool TranslationsDetermined(
     const InitProblem& problem,
     const std::vector<std::optional<Eigen::Quaterniond>>& cam_rotations,
@@ -46,7 +44,8 @@ bool TranslationsDetermined(
   return system.reduced.rows() == 0 ||
          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(system.reduced,
                                                         Eigen::EigenvaluesOnly)
-                 .eigenvalues()(0) >= 0.5 * problem.min_axis_eigenvalue;
+                 .eigenvalues()(0) >=
+             0.5 * AxisEigenvalueOfAngle(kMinDeterminingAxisAngleDeg);
 }
 
 // The cameras of `parts` that join the anchor one by one (see

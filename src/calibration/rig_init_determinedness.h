@@ -3,9 +3,9 @@
 //
 // A frameset's rig translation t_Q is determined by one full pose, or by the
 // radial rows of two or more cameras whose principal axes z_k (rig frame)
-// make sum_k (I - z_k z_k^T) regular: its smallest eigenvalue at least
-// problem.min_axis_eigenvalue (AxesDetermineTranslation, principal_axes.h;
-// parallel and anti-parallel axes alike are not enough). A camera needs
+// make sum_k (I - z_k z_k^T) regular (AxesDetermineTranslation with
+// kMinDeterminingAxisAngleDeg, principal_axes.h; parallel and anti-parallel
+// axes alike are not enough). A camera needs
 // images in such framesets, and all camera translations together must be
 // determined relative to an anchor camera (TranslationsDetermined, through
 // the reduced system of rig_init_translations.h).

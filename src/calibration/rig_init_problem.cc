@@ -9,7 +9,6 @@
 #include <sstream>
 #include <utility>
 
-#include "src/calibration/principal_axes.h"
 #include "src/calibration/rig_init_scoring.h"
 
 namespace rig_calibrator {
@@ -129,8 +128,6 @@ std::string BuildProblem(const RigInitializerOptions& options,
   problem->num_framesets = dataset.frameset_names.size();
   problem->reference_camera = dataset.reference_camera;
   problem->num_rows = options.radial ? 2 : 3;
-  problem->min_axis_eigenvalue =
-      AxisEigenvalueOfAngle(options.min_principal_axis_angle_deg);
   problem->max_rotation_deviation =
       colmap::DegToRad(options.max_rotation_deviation_deg);
   problem->num_threads = colmap::GetEffectiveNumThreads(options.num_threads);

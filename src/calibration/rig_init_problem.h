@@ -39,9 +39,6 @@ struct InitProblem {
   int num_framesets = 0;
   int reference_camera = 0;
   int num_rows = 2;  // known rows of each pose: 2 radial, 3 full
-  // Smallest eigenvalue of sum_k (I - z_k z_k^T) over the cameras' axes z_k
-  // that determines a rig translation in eq. 3 (principal_axes.h).
-  double min_axis_eigenvalue = 0;
   double max_rotation_deviation = 0;  // radians
   int num_threads = 1;
   std::vector<LocalizedImage> images;

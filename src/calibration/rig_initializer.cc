@@ -245,13 +245,14 @@ bool InitializeRig(const RigInitializerOptions& options,
 
   if (options.radial) {
     std::string explanation;
+    // No pair of cameras would determine a frameset: fail with the reason
+    // rather than later with an unplaceable reference camera.
     if (PrincipalAxesAreParallel(dataset, *calibration,
-                                 options.min_principal_axis_angle_deg,
-                                 &explanation)) {
+                                 kMinDeterminingAxisAngleDeg, &explanation)) {
       return Fail(explanation +
                       "; 1D radial poses cannot determine the rig poses of "
-                      "a rig with parallel principal axes: use full "
-                      "per-image poses (the rd_ra method)",
+                      "a rig with parallel or anti-parallel principal axes: "
+                      "use full per-image poses (the rd_ra method)",
                   summary);
     }
   }

@@ -58,9 +58,6 @@ struct RigInitializerOptions {
   // Radians per map unit: weight of the translation difference against the
   // rotation difference in d(T, P Q).
   double translation_weight = 1.0;
-  // Radial rigs: two cameras whose principal axes are closer to parallel
-  // than this do not determine a rig pose's translation (eq. 3).
-  double min_principal_axis_angle_deg = 5.0;
   int num_threads = -1;
   unsigned int seed = 0;
 };
@@ -111,10 +108,11 @@ struct RigInitializerSummary {
 //     the image's scene center X. They are solved jointly by least squares
 //     over all images whose rotation agrees with the rig (each frameset's
 //     t_Q eliminated by Schur complement; radial rigs need two cameras with
-//     non-parallel axes per frameset), iteratively reweighted (Cauchy), and
-//     once more over those whose correspondences agree with the result.
-//     Cameras whose translation the images leave (nearly) undetermined are
-//     dropped: e.g. a radial camera seen only in framesets of two cameras
+//     axes neither parallel nor anti-parallel per frameset,
+//     kMinDeterminingAxisAngleDeg in principal_axes.h), iteratively reweighted
+//     (Cauchy), and once more over those whose correspondences agree with the
+//     result. Cameras whose translation the images leave (nearly) undetermined
+//     are dropped: e.g. a radial camera seen only in framesets of two cameras
 //     can slide along its partner's axis, and within the plane of the axes
 //     if they are (nearly) coplanar, as in a ring.
 // An image agrees with a pose if both its own pose and that pose put >= 5 of
@@ -125,7 +123,9 @@ struct RigInitializerSummary {
 // minimized over those.
 //
 // Returns false (message in summary->message and the log) on inconsistent
-// input, on radial rigs with parallel principal axes, or if the reference
+// input, on radial rigs whose principal axes are all within
+// kMinDeterminingAxisAngleDeg of parallel or anti-parallel (no pair of
+// cameras determines a frameset; PrincipalAxesAreParallel), or if the reference
 // camera cannot be placed. Deterministic for a given seed. summary may be
 // null.
 bool InitializeRig(const RigInitializerOptions& options,
