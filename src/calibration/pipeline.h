@@ -29,6 +29,7 @@
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
 #include "src/calibration/pipeline_report.h"
+#include "src/calibration/principal_axes.h"
 #include "src/calibration/radial_bundle_adjuster.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/calibration/rig_initializer.h"
@@ -39,8 +40,10 @@ struct PipelineOptions {
   CalibrationMethod method = CalibrationMethod::kRadial1D;
   // 1dr on a rig with parallel principal axes: fall back to rd_ra (else fail).
   bool fallback_on_parallel_axes = true;
-  // Cameras whose principal axes are within this angle count as parallel.
-  double parallel_axes_max_angle_deg = 10.0;
+  // Rigs on which every pair of cameras is within this angle of parallel or
+  // anti-parallel (e.g. a stereo pair, a front/back pair) count as parallel
+  // (PrincipalAxesAreParallel; why 10 degrees: principal_axes.h).
+  double parallel_axes_max_angle_deg = kParallelAxesMaxAngleDeg;
 
   InitialPoseOptions initial_pose;
   RigInitializerOptions rig_initializer;

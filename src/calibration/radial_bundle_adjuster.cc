@@ -5,15 +5,14 @@
 #include <colmap/util/threading.h>
 #include <glog/logging.h>
 
-#include <Eigen/Eigenvalues>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <vector>
 
+#include "src/calibration/principal_axes.h"
 #include "src/geometry/radial_rig_cost_function.h"
-#include "src/calibration/rig_initializer.h"
 
 namespace rig_calibrator {
 namespace {
@@ -64,14 +63,13 @@ double RmsRadialError(const std::vector<Observation>& observations,
   return std::sqrt(sum_sq / observations.size());
 }
 
-// The observations of the framesets whose rig pose they determine. With
-// radial projections a rig pose's translation is determined iff
-// sum_k (I - z_k z_k^T) over the principal axes z_k (in the rig frame) of
-// the cameras observing it is regular; only cameras with
-// kMinInliersPerImage observations in the frameset count.
+// The observations of the framesets whose rig pose they determine
+// (AxesDetermineTranslation over the principal axes, in the rig frame, of the
+// cameras observing it: parallel and anti-parallel axes do not); only
+// cameras with kMinInliersPerImage observations in the frameset count.
 std::vector<Observation> KeepDeterminedFramesets(
     const std::vector<Observation>& observations,
-    const RigCalibration& calibration, double min_axis_eigenvalue) {
+    const RigCalibration& calibration) {
   const int num_framesets = calibration.rig_from_world.size();
   std::vector<std::vector<int>> count_of_camera(
       num_framesets, std::vector<int>(calibration.cam_from_rig.size(), 0));
@@ -80,19 +78,13 @@ std::vector<Observation> KeepDeterminedFramesets(
   }
   std::vector<char> determined(num_framesets, 0);
   for (int j = 0; j < num_framesets; ++j) {
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    int num_cameras = 0;
+    std::vector<Eigen::Vector3d> axes;
     for (size_t i = 0; i < count_of_camera[j].size(); ++i) {
-      if (count_of_camera[j][i] < kMinInliersPerImage) continue;
-      const Eigen::Vector3d axis =
-          calibration.cam_from_rig[i].RotationMatrix().row(2).transpose();
-      normal += Eigen::Matrix3d::Identity() - axis * axis.transpose();
-      ++num_cameras;
+      if (count_of_camera[j][i] >= kMinInliersPerImage) {
+        axes.push_back(PrincipalAxis(calibration.cam_from_rig[i]));
+      }
     }
-    determined[j] =
-        num_cameras >= 2 && Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                normal, Eigen::EigenvaluesOnly)
-                                    .eigenvalues()(0) >= min_axis_eigenvalue;
+    determined[j] = AxesDetermineTranslation(axes);
   }
   std::vector<Observation> kept;
   for (const Observation& observation : observations) {
@@ -243,122 +235,81 @@ std::string CheckInput(const RigDataset& dataset,
   return "";
 }
 
-}  // namespace
-
-bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
-                     const RigDataset& dataset, RigCalibration* calibration,
-                     RadialBundleAdjustmentSummary* summary) {
-  const auto start_time = std::chrono::steady_clock::now();
-  if (summary) *summary = RadialBundleAdjustmentSummary();
-  if (calibration == nullptr) return Fail("no calibration given", summary);
-  const std::string error = CheckInput(dataset, *calibration);
-  if (!error.empty()) return Fail(error, summary);
-  if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0 ||
-      !(options.max_radial_error_px >= 0)) {
-    return Fail(
-        "loss_scale_px must be positive, max_num_iterations and "
-        "max_radial_error_px non-negative",
-        summary);
-  }
-  const int num_cameras = dataset.cameras.size();
-  const int num_framesets = dataset.frameset_names.size();
-  const int reference = dataset.reference_camera;
-  const double min_axis_eigenvalue =
-      1.0 - std::cos(options.min_principal_axis_angle_deg * M_PI / 180.0);
-
-  // Inlier correspondences of images of calibrated cameras in posed
-  // framesets that their observations determine.
-  std::vector<Observation> candidates;
+// Inlier correspondences of the images of calibrated cameras in posed
+// framesets.
+std::vector<Observation> InlierObservations(const RigDataset& dataset,
+                                            const RigCalibration& calibration) {
+  std::vector<Observation> observations;
   for (size_t k = 0; k < dataset.images.size(); ++k) {
     const RigImage& image = dataset.images[k];
-    const std::vector<char>& mask = calibration->images[k].inlier_mask;
-    if (!calibration->camera_calibrated[image.camera_index] ||
-        !calibration->rig_from_world[image.frameset_index]) {
+    const std::vector<char>& mask = calibration.images[k].inlier_mask;
+    if (!calibration.camera_calibrated[image.camera_index] ||
+        !calibration.rig_from_world[image.frameset_index]) {
       continue;
     }
     for (size_t c = 0; c < mask.size(); ++c) {
       if (mask[c]) {
-        candidates.push_back({static_cast<int>(k), image.camera_index,
-                              image.frameset_index,
-                              image.correspondences[c].point2D,
-                              image.correspondences[c].point3D});
+        observations.push_back({static_cast<int>(k), image.camera_index,
+                                image.frameset_index,
+                                image.correspondences[c].point2D,
+                                image.correspondences[c].point3D});
       }
     }
   }
-  std::vector<Observation> observations =
-      KeepDeterminedFramesets(candidates, *calibration, min_axis_eigenvalue);
-  const std::string no_reference_message =
-      "the reference camera " + dataset.cameras[reference].name +
-      " has no inlier correspondences in framesets with a determined rig pose";
-  if (!ObservesReference(observations, reference)) {
-    return Fail(no_reference_message, summary);
-  }
+  return observations;
+}
 
+// The calibration's poses and principal points as parameter blocks.
+Parameters ParametersOf(const RigCalibration& calibration) {
   Parameters parameters;
-  parameters.cam_from_rig.resize(num_cameras);
-  parameters.principal_points.resize(num_cameras);
-  for (int i = 0; i < num_cameras; ++i) {
-    parameters.cam_from_rig[i] =
-        ToAngleAxisTranslation(calibration->cam_from_rig[i]);
-    parameters.principal_points[i] = {
-        calibration->cameras[i].PrincipalPointX(),
-        calibration->cameras[i].PrincipalPointY()};
+  for (size_t i = 0; i < calibration.cam_from_rig.size(); ++i) {
+    parameters.cam_from_rig.push_back(
+        ToAngleAxisTranslation(calibration.cam_from_rig[i]));
+    parameters.principal_points.push_back(
+        {calibration.cameras[i].PrincipalPointX(),
+         calibration.cameras[i].PrincipalPointY()});
   }
-  parameters.rig_from_world.resize(num_framesets);
-  for (int j = 0; j < num_framesets; ++j) {
-    if (calibration->rig_from_world[j]) {
+  parameters.rig_from_world.resize(calibration.rig_from_world.size());
+  for (size_t j = 0; j < calibration.rig_from_world.size(); ++j) {
+    if (calibration.rig_from_world[j]) {
       parameters.rig_from_world[j] =
-          ToAngleAxisTranslation(*calibration->rig_from_world[j]);
+          ToAngleAxisTranslation(*calibration.rig_from_world[j]);
     }
   }
-  const double initial_rms = RmsRadialError(observations, parameters);
+  return parameters;
+}
 
-  // The Cauchy loss bounds the pull of each wrong correspondence, but the
-  // correspondences of a mis-localized image agree with one another, and a
-  // principal point shift is nearly a pan/tilt of the camera, a weakly
-  // constrained direction in which small coherent pulls add up. So after a
-  // first solve, the images with fewer than kMinInlierShare of their
-  // correspondences within max_radial_error_px are dropped whole (a few of a
-  // wrong image's points always fall near the predicted lines), the
-  // remaining correspondences beyond it too, and the rest solved again.
-  ceres::Solver::Summary solver_summary =
-      Solve(options, observations, reference, &parameters);
-  int num_iterations = solver_summary.iterations.size();
-  int num_outliers = 0;
-  if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
-    std::vector<char> within(observations.size(), 0);
-    std::vector<int> num_selected(dataset.images.size(), 0);
-    std::vector<int> num_within(dataset.images.size(), 0);
-    for (size_t n = 0; n < observations.size(); ++n) {
-      within[n] = RadialError(observations[n], parameters) <=
-                  options.max_radial_error_px;
-      ++num_selected[observations[n].image];
-      num_within[observations[n].image] += within[n];
-    }
-    std::vector<Observation> inliers;
-    for (size_t n = 0; n < observations.size(); ++n) {
-      const int image = observations[n].image;
-      if (within[n] &&
-          num_within[image] >= kMinInlierShare * num_selected[image]) {
-        inliers.push_back(observations[n]);
-      }
-    }
-    num_outliers = observations.size() - inliers.size();
-    if (num_outliers > 0) {
-      observations =
-          KeepDeterminedFramesets(inliers, *calibration, min_axis_eigenvalue);
-      if (!ObservesReference(observations, reference)) {
-        return Fail(no_reference_message + " after removing outliers", summary);
-      }
-      solver_summary = Solve(options, observations, reference, &parameters);
-      num_iterations += solver_summary.iterations.size();
+// The observations within max_error of the solution whose image has at
+// least kMinInlierShare of its observations within it (see AdjustRadialRig).
+std::vector<Observation> KeepInliers(
+    const std::vector<Observation>& observations, const Parameters& parameters,
+    int num_images, double max_error) {
+  std::vector<char> within(observations.size(), 0);
+  std::vector<int> num_selected(num_images, 0);
+  std::vector<int> num_within(num_images, 0);
+  for (size_t n = 0; n < observations.size(); ++n) {
+    within[n] = RadialError(observations[n], parameters) <= max_error;
+    ++num_selected[observations[n].image];
+    num_within[observations[n].image] += within[n];
+  }
+  std::vector<Observation> inliers;
+  for (size_t n = 0; n < observations.size(); ++n) {
+    const int image = observations[n].image;
+    if (within[n] &&
+        num_within[image] >= kMinInlierShare * num_selected[image]) {
+      inliers.push_back(observations[n]);
     }
   }
-  if (!solver_summary.IsSolutionUsable()) {
-    return Fail("the solver failed: " + solver_summary.message, summary);
-  }
+  return inliers;
+}
 
-  // Write back what the final solve adjusted.
+// Writes back what the final solve adjusted (tz = 0, the reference camera
+// the identity). Returns the number of rig poses it did not adjust.
+int WriteAdjusted(const std::vector<Observation>& observations,
+                  const Parameters& parameters, int reference,
+                  RigCalibration* calibration) {
+  const int num_cameras = calibration->cam_from_rig.size();
+  const int num_framesets = calibration->rig_from_world.size();
   std::vector<char> cam_adjusted(num_cameras, 0);
   std::vector<char> rig_adjusted(num_framesets, 0);
   for (const Observation& observation : observations) {
@@ -385,6 +336,69 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
       ++num_skipped;
     }
   }
+  return num_skipped;
+}
+
+}  // namespace
+
+bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
+                     const RigDataset& dataset, RigCalibration* calibration,
+                     RadialBundleAdjustmentSummary* summary) {
+  const auto start_time = std::chrono::steady_clock::now();
+  if (summary) *summary = RadialBundleAdjustmentSummary();
+  if (calibration == nullptr) return Fail("no calibration given", summary);
+  const std::string error = CheckInput(dataset, *calibration);
+  if (!error.empty()) return Fail(error, summary);
+  if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0 ||
+      !(options.max_radial_error_px >= 0)) {
+    return Fail(
+        "loss_scale_px must be positive, max_num_iterations and "
+        "max_radial_error_px non-negative",
+        summary);
+  }
+  const int reference = dataset.reference_camera;
+  std::vector<Observation> observations = KeepDeterminedFramesets(
+      InlierObservations(dataset, *calibration), *calibration);
+  const std::string no_reference_message =
+      "the reference camera " + dataset.cameras[reference].name +
+      " has no inlier correspondences in framesets with a determined rig pose";
+  if (!ObservesReference(observations, reference)) {
+    return Fail(no_reference_message, summary);
+  }
+  Parameters parameters = ParametersOf(*calibration);
+  const double initial_rms = RmsRadialError(observations, parameters);
+
+  // The Cauchy loss bounds the pull of each wrong correspondence, but the
+  // correspondences of a mis-localized image agree with one another, and a
+  // principal point shift is nearly a pan/tilt of the camera, a weakly
+  // constrained direction in which small coherent pulls add up. So after a
+  // first solve, the images with fewer than kMinInlierShare of their
+  // correspondences within max_radial_error_px are dropped whole (a few of a
+  // wrong image's points always fall near the predicted lines), the
+  // remaining correspondences beyond it too, and the rest solved again.
+  ceres::Solver::Summary solver_summary =
+      Solve(options, observations, reference, &parameters);
+  int num_iterations = solver_summary.iterations.size();
+  int num_outliers = 0;
+  if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
+    const std::vector<Observation> inliers =
+        KeepInliers(observations, parameters, dataset.images.size(),
+                    options.max_radial_error_px);
+    num_outliers = observations.size() - inliers.size();
+    if (num_outliers > 0) {
+      observations = KeepDeterminedFramesets(inliers, *calibration);
+      if (!ObservesReference(observations, reference)) {
+        return Fail(no_reference_message + " after removing outliers", summary);
+      }
+      solver_summary = Solve(options, observations, reference, &parameters);
+      num_iterations += solver_summary.iterations.size();
+    }
+  }
+  if (!solver_summary.IsSolutionUsable()) {
+    return Fail("the solver failed: " + solver_summary.message, summary);
+  }
+  const int num_skipped =
+      WriteAdjusted(observations, parameters, reference, calibration);
   NormalizeRadialRigOrigin(reference, calibration);
 
   if (summary) {

@@ -22,10 +22,6 @@ struct RadialBundleAdjustmentOptions {
   double loss_scale_px = 1.0;  // Cauchy scale, pixels
   int max_num_iterations = 100;
   bool refine_principal_points = true;
-  // A rig pose is only adjusted if its frameset has images with inliers in
-  // two cameras whose principal axes differ by at least this angle: with
-  // radial projections, fewer do not determine the rig pose.
-  double min_principal_axis_angle_deg = 5.0;
   // After a first solve, correspondences with a larger radial error (pixels)
   // are dropped, and images with fewer than half of theirs within it are
   // dropped whole; the rest is solved again. The Cauchy loss bounds each
@@ -46,9 +42,9 @@ struct RadialBundleAdjustmentSummary {
   int num_outliers = 0;    // correspondences dropped (max_radial_error_px)
   int num_iterations = 0;  // of both solves
   double seconds = 0;
-  // Framesets with a rig pose that their images do not determine (see
-  // min_principal_axis_angle_deg) in the final solve; their rig pose is left
-  // as it was (or as the first solve left it).
+  // Framesets with a rig pose that their images do not determine
+  // (AxesDetermineTranslation, principal_axes.h) in the final solve; their rig
+  // pose is left as it was (or as the first solve left it).
   int num_framesets_skipped = 0;
   std::string message;  // why AdjustRadialRig failed; empty on success
 };

@@ -16,15 +16,16 @@
 // the rig origin can slide by d along the reference camera's axis, which
 // changes no radial projection but changes every other camera's (tx, ty) by
 // d (R_i e_z)_xy. The radial stages therefore store tz = 0 for every camera
-// and fix d with NormalizeRadialRigOrigin below; the reference camera's
-// cam_from_rig is the identity in that sense (its tz is unknown). Once the
-// forward translations are estimated (upgrade, MATH.md §3), including the
+// and fix d with NormalizeRadialRigOrigin (principal_axes.h); the reference
+// camera's cam_from_rig is the identity in that sense (its tz is unknown). Once
+// the forward translations are estimated (upgrade, MATH.md §3), including the
 // reference camera's, re-expressing everything in the reference camera's
 // frame (Q_j <- P_ref Q_j, P_i <- P_i P_ref^-1) makes the rig metric.
 #pragma once
 
 #include <string>
 
+#include "src/calibration/principal_axes.h"
 #include "src/calibration/rig_dataset.h"
 
 namespace rig_calibrator {
@@ -57,9 +58,6 @@ struct RigInitializerOptions {
   // Radians per map unit: weight of the translation difference against the
   // rotation difference in d(T, P Q).
   double translation_weight = 1.0;
-  // Radial rigs: two cameras whose principal axes are closer to parallel
-  // than this do not determine a rig pose's translation (eq. 3).
-  double min_principal_axis_angle_deg = 5.0;
   int num_threads = -1;
   unsigned int seed = 0;
 };
@@ -110,10 +108,11 @@ struct RigInitializerSummary {
 //     the image's scene center X. They are solved jointly by least squares
 //     over all images whose rotation agrees with the rig (each frameset's
 //     t_Q eliminated by Schur complement; radial rigs need two cameras with
-//     non-parallel axes per frameset), iteratively reweighted (Cauchy), and
-//     once more over those whose correspondences agree with the result.
-//     Cameras whose translation the images leave (nearly) undetermined are
-//     dropped: e.g. a radial camera seen only in framesets of two cameras
+//     axes neither parallel nor anti-parallel per frameset,
+//     kMinDeterminingAxisAngleDeg in principal_axes.h), iteratively reweighted
+//     (Cauchy), and once more over those whose correspondences agree with the
+//     result. Cameras whose translation the images leave (nearly) undetermined
+//     are dropped: e.g. a radial camera seen only in framesets of two cameras
 //     can slide along its partner's axis, and within the plane of the axes
 //     if they are (nearly) coplanar, as in a ring.
 // An image agrees with a pose if both its own pose and that pose put >= 5 of
@@ -124,35 +123,13 @@ struct RigInitializerSummary {
 // minimized over those.
 //
 // Returns false (message in summary->message and the log) on inconsistent
-// input, on radial rigs with parallel principal axes, or if the reference
+// input, on radial rigs whose principal axes are all within
+// kMinDeterminingAxisAngleDeg of parallel or anti-parallel (no pair of
+// cameras determines a frameset; PrincipalAxesAreParallel), or if the reference
 // camera cannot be placed. Deterministic for a given seed. summary may be
 // null.
 bool InitializeRig(const RigInitializerOptions& options,
                    const RigDataset& dataset, RigCalibration* calibration,
                    RigInitializerSummary* summary);
-
-// Parallel-axes diagnosis (paper Limitations, MATH.md §4). From the
-// per-image poses calibration.images[i].single_image_cam_from_world: for
-// every pair of cameras, the median over the framesets where both are
-// localized of the angle between their principal axes (third rows of the
-// rotations). Returns true if every pair's median is at most max_angle_deg,
-// i.e. a radial rig cannot be fixed (use full per-image poses, `rd_ra`).
-// Returns false if some pair is farther from parallel, and also if no
-// frameset has two localized images (nothing to judge); `explanation` (may be
-// null) says which.
-bool PrincipalAxesAreParallel(const RigDataset& dataset,
-                              const RigCalibration& calibration,
-                              double max_angle_deg, std::string* explanation);
-
-// Fixes the gauge of a radial rig (see the top of this file): moves the rig
-// origin along the reference camera's principal axis to the point closest,
-// in least squares, to the principal axes of the other calibrated cameras,
-//   d = -sum_i g_i . t_i,xy / sum_i |g_i|^2,  g_i = (R_i e_z)_xy,
-// then t_i,xy += d g_i, every rig_from_world translation -= d e_z, and tz = 0
-// for all cameras. |t_i,xy| is the distance of the rig origin from camera i's
-// axis. The radial projections do not change. Does nothing to the
-// translations if all calibrated cameras are parallel to the reference.
-void NormalizeRadialRigOrigin(int reference_camera,
-                              RigCalibration* calibration);
 
 }  // namespace rig_calibrator

@@ -6,17 +6,13 @@
 #include <cmath>
 #include <random>
 
+#include "src/calibration/principal_axes.h"
 #include "src/calibration/rig_initializer.h"
 #include "tests/src/calibration/radial_rig_scene.h"
 
 namespace rig_calibrator {
+namespace testing {
 namespace {
-
-using testing::MakeRadialRigScene;
-using testing::RadialRigScene;
-using testing::RadialRigSceneOptions;
-using testing::RotationAbout;
-using testing::RotationDistance;
 
 // The truth's rig with rotations turned by about `angle_deg` and translations
 // moved by about `shift` (tx, ty of the cameras; all of the rig poses): the
@@ -78,32 +74,14 @@ TEST(AdjustRadialRig, ExactDataRecoversTruth) {
   EXPECT_GT(summary.initial_rms_px, 1);
   EXPECT_LT(summary.final_rms_px, 1e-6);
 
-  RigCalibration truth = scene.truth;
-  NormalizeRadialRigOrigin(0, &truth);
+  const RigCalibration truth = RadialTruth(scene);
   EXPECT_EQ(calibration.cam_from_rig[0].ToMatrix(), Rigid3d().ToMatrix());
   for (int i = 0; i < 5; ++i) {
     EXPECT_LT(PrincipalPointError(calibration.cameras[i], truth.cameras[i]),
               1e-6)
         << i;
-    EXPECT_LT(
-        RotationDistance(calibration.cam_from_rig[i], truth.cam_from_rig[i]),
-        1e-8)
-        << i;
-    EXPECT_LT((calibration.cam_from_rig[i].translation -
-               truth.cam_from_rig[i].translation)
-                  .norm(),
-              1e-8)
-        << i;
   }
-  for (size_t j = 0; j < truth.rig_from_world.size(); ++j) {
-    EXPECT_LT(RotationDistance(*calibration.rig_from_world[j],
-                               *truth.rig_from_world[j]),
-              1e-8);
-    EXPECT_LT((calibration.rig_from_world[j]->translation -
-               truth.rig_from_world[j]->translation)
-                  .norm(),
-              1e-8);
-  }
+  ExpectRigNear(calibration, truth, 1e-8);
 }
 
 TEST(AdjustRadialRig, NoisyDataRecoversPrincipalPointsAndRotations) {
@@ -125,8 +103,7 @@ TEST(AdjustRadialRig, NoisyDataRecoversPrincipalPointsAndRotations) {
   EXPECT_LT(summary.final_rms_px, 0.6);
   EXPECT_EQ(summary.num_framesets_skipped, 0);
 
-  RigCalibration truth = scene.truth;
-  NormalizeRadialRigOrigin(0, &truth);
+  const RigCalibration truth = RadialTruth(scene);
   double max_pp_error = 0, max_rotation_deg = 0, max_rig_rotation_deg = 0;
   for (int i = 0; i < 5; ++i) {
     max_pp_error =
@@ -183,8 +160,7 @@ TEST(AdjustRadialRig, AfterInitializationWithOutliers) {
   }
   EXPECT_GE(summary.num_outliers, num_wrong_correspondences);
   EXPECT_LT(summary.final_rms_px, 0.6);
-  RigCalibration truth = scene.truth;
-  NormalizeRadialRigOrigin(0, &truth);
+  const RigCalibration truth = RadialTruth(scene);
   for (int i = 0; i < 5; ++i) {
     EXPECT_LT(PrincipalPointError(calibration.cameras[i], truth.cameras[i]),
               1.0)
@@ -235,6 +211,30 @@ TEST(AdjustRadialRig, RigPoseSeenByOneCameraIsSkipped) {
             before.rotation.coeffs());
 }
 
+// A frameset seen by two cameras whose axes are (nearly) parallel or
+// anti-parallel does not determine its rig pose: a front/back pair has no
+// frameset to adjust, while a pair at right angles has all of them.
+TEST(AdjustRadialRig, FramesetsOfAntiParallelPairAreNotAdjusted) {
+  for (const double yaw_deg : {178.0, 180.0, 2.0, 90.0}) {
+    SCOPED_TRACE("pair yaw " + std::to_string(yaw_deg) + " degrees");
+    const RadialRigScene scene = MakePairScene(yaw_deg);
+    RigCalibration calibration = PerturbedTruth(scene, 0.2, 0.01, 6);
+    RadialBundleAdjustmentSummary summary;
+    const bool adjusted = AdjustRadialRig(
+        RadialBundleAdjustmentOptions(), scene.dataset, &calibration, &summary);
+    if (yaw_deg == 90.0) {
+      ASSERT_TRUE(adjusted) << summary.message;
+      EXPECT_EQ(summary.num_framesets_skipped, 0);
+      EXPECT_LT(summary.final_rms_px, 1e-6);
+    } else {
+      EXPECT_FALSE(adjusted);
+      EXPECT_NE(summary.message.find("framesets with a determined rig pose"),
+                std::string::npos)
+          << summary.message;
+    }
+  }
+}
+
 TEST(AdjustRadialRig, InconsistentInputFails) {
   const RadialRigScene scene = MakeRadialRigScene(OffCenterOptions(0));
   RigCalibration calibration = PerturbedTruth(scene, 0, 0, 5);
@@ -264,4 +264,5 @@ TEST(AdjustRadialRig, InconsistentInputFails) {
 }
 
 }  // namespace
+}  // namespace testing
 }  // namespace rig_calibrator

@@ -6,15 +6,18 @@
 #pragma once
 
 #include <colmap/base/camera.h>
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "src/calibration/principal_axes.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/geometry/rigid3d.h"
 
@@ -24,9 +27,11 @@ namespace testing {
 struct RadialRigSceneOptions {
   // false: 5 cameras on a ring, looking outward at 72 degree steps, centers
   // 0.12-0.18 m from the ring center, pitched and rolled by a few degrees.
-  // true: a forward-looking stereo pair with a 0.11 m baseline (parallel
-  // principal axes).
-  bool stereo = false;
+  // true: two cameras 0.11 m apart along x, the first looking forward, the
+  // second turned by pair_yaw_deg about the vertical axis: 0 a stereo pair
+  // (parallel principal axes), 180 a front/back pair (anti-parallel).
+  bool pair = false;
+  double pair_yaw_deg = 0;
   int num_framesets = 30;
   int points_per_image = 60;
   // Gaussian noise on each pixel coordinate.
@@ -113,21 +118,17 @@ inline std::vector<Correspondence> MakeCorrespondences(
   return correspondences;
 }
 
-inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
-  std::mt19937 random(options.seed);
-  std::uniform_real_distribution<double> uniform(0, 1);
-  std::normal_distribution<double> normal;
-  RadialRigScene scene;
-  RigDataset& dataset = scene.dataset;
-
-  // Rig body frame: x right, y down, z forward (camera-like); the ring's
-  // cameras turn about y.
+// The cameras' poses in the rig body frame: x right, y down, z forward
+// (camera-like); the ring's cameras turn about y.
+inline std::vector<Rigid3d> CamFromBody(const RadialRigSceneOptions& options) {
   std::vector<Rigid3d> cam_from_body;
-  if (options.stereo) {
+  if (options.pair) {
     cam_from_body.push_back(
         Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.055, 0, 0)));
     cam_from_body.push_back(
-        Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.055, 0, 0)));
+        Rigid3d(RotationAbout(Eigen::Vector3d::UnitY(), options.pair_yaw_deg),
+                Eigen::Vector3d(0.055, 0, 0))
+            .Inverse());
   } else {
     for (int i = 0; i < 5; ++i) {
       const double yaw = 72.0 * i;
@@ -143,6 +144,83 @@ inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
           Rigid3d(body_from_cam_rotation, center).Inverse());
     }
   }
+  return cam_from_body;
+}
+
+// The scene's random numbers: one engine and one distribution of each kind,
+// drawn in a fixed order (a normal distribution keeps state between draws).
+struct SceneRandom {
+  explicit SceneRandom(unsigned int seed) : engine(seed) {}
+  double Uniform() { return uniform(engine); }
+  double Normal() { return normal(engine); }
+  std::mt19937 engine;
+  std::uniform_real_distribution<double> uniform{0, 1};
+  std::normal_distribution<double> normal;
+};
+
+// Camera i's image of frameset j, appended to the scene: correct (with the
+// pose noise), mis-localized or not localized, as drawn.
+inline void AddImage(const RadialRigSceneOptions& options, int i, int j,
+                     SceneRandom* random, RadialRigScene* scene) {
+  const Rigid3d true_cam_from_world =
+      scene->truth.cam_from_rig[i] * *scene->truth.rig_from_world[j];
+  RigImage image;
+  image.name = "cam" + std::to_string(i) + "/" + std::to_string(j);
+  image.camera_index = i;
+  image.frameset_index = j;
+  ImageResult result;
+  const double kind = random->Uniform();
+  const bool garbage = kind < options.garbage_ratio;
+  const bool missing =
+      !garbage && kind < options.garbage_ratio + options.missing_ratio;
+  Rigid3d cam_from_world = true_cam_from_world;
+  if (garbage) {
+    cam_from_world =
+        Rigid3d(RandomRotation(&random->engine),
+                Eigen::Vector3d(3 * random->Normal(), 3 * random->Normal(), 0));
+  }
+  image.correspondences = MakeCorrespondences(
+      scene->truth.cameras[i], cam_from_world, options.points_per_image,
+      options.noise_px, &random->engine);
+  if (!garbage) {
+    // A single-image pose errs about the points it sees: the rotation
+    // turns about their centroid, whose image stays put.
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Correspondence& correspondence : image.correspondences) {
+      centroid += correspondence.point3D / image.correspondences.size();
+    }
+    const Eigen::Vector3d axis(random->Normal(), random->Normal(),
+                               random->Normal());
+    const Eigen::Vector3d centroid_in_cam = cam_from_world * centroid;
+    cam_from_world.rotation =
+        RotationAbout(axis, options.pose_noise_deg * random->Normal()) *
+        cam_from_world.rotation;
+    cam_from_world.translation =
+        centroid_in_cam - cam_from_world.rotation * centroid;
+    cam_from_world.translation.x() +=
+        options.pose_noise_translation * random->Normal();
+    cam_from_world.translation.y() +=
+        options.pose_noise_translation * random->Normal();
+  }
+  if (!missing) {
+    // The forward translation is unknown to a radial pose.
+    cam_from_world.translation.z() = 10 * random->Normal();
+    result.localized = true;
+    result.single_image_cam_from_world = cam_from_world;
+    result.inlier_mask.assign(image.correspondences.size(), 1);
+    result.num_inliers = image.correspondences.size();
+  }
+  scene->dataset.images.push_back(image);
+  scene->input.images.push_back(result);
+  scene->garbage.push_back(garbage);
+}
+
+inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
+  SceneRandom random(options.seed);
+  RadialRigScene scene;
+  RigDataset& dataset = scene.dataset;
+
+  const std::vector<Rigid3d> cam_from_body = CamFromBody(options);
   const int num_cameras = cam_from_body.size();
   const Rigid3d body_from_rig = cam_from_body[0].Inverse();
 
@@ -160,7 +238,7 @@ inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
     RigCamera rig_camera;
     rig_camera.name = "cam" + std::to_string(i);
     rig_camera.camera = camera;
-    const double direction = 2 * M_PI * uniform(random);
+    const double direction = 2 * M_PI * random.Uniform();
     rig_camera.camera.SetPrincipalPointX(camera.PrincipalPointX() +
                                          options.principal_point_error_px *
                                              std::cos(direction));
@@ -185,75 +263,88 @@ inline RadialRigScene MakeRadialRigScene(const RadialRigSceneOptions& options) {
 
     std::vector<int> cameras(num_cameras);
     std::iota(cameras.begin(), cameras.end(), 0);
-    std::shuffle(cameras.begin(), cameras.end(), random);
+    std::shuffle(cameras.begin(), cameras.end(), random.engine);
     const int num_present =
         options.min_cameras_per_frameset +
-        static_cast<int>(uniform(random) *
+        static_cast<int>(random.Uniform() *
                          (options.max_cameras_per_frameset -
                           options.min_cameras_per_frameset + 1));
     cameras.resize(std::min(num_present, num_cameras));
     std::sort(cameras.begin(), cameras.end());
     for (const int i : cameras) {
-      const Rigid3d true_cam_from_world =
-          scene.truth.cam_from_rig[i] * *scene.truth.rig_from_world[j];
-      RigImage image;
-      image.name = "cam" + std::to_string(i) + "/" + std::to_string(j);
-      image.camera_index = i;
-      image.frameset_index = j;
-      ImageResult result;
-      const double kind = uniform(random);
-      const bool garbage = kind < options.garbage_ratio;
-      const bool missing =
-          !garbage && kind < options.garbage_ratio + options.missing_ratio;
-      Rigid3d cam_from_world = true_cam_from_world;
-      if (garbage) {
-        cam_from_world =
-            Rigid3d(RandomRotation(&random),
-                    Eigen::Vector3d(3 * normal(random), 3 * normal(random), 0));
-      }
-      image.correspondences = MakeCorrespondences(
-          scene.truth.cameras[i], cam_from_world, options.points_per_image,
-          options.noise_px, &random);
-      if (!garbage) {
-        // A single-image pose errs about the points it sees: the rotation
-        // turns about their centroid, whose image stays put.
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (const Correspondence& correspondence : image.correspondences) {
-          centroid += correspondence.point3D / image.correspondences.size();
-        }
-        const Eigen::Vector3d axis(normal(random), normal(random),
-                                   normal(random));
-        const Eigen::Vector3d centroid_in_cam = cam_from_world * centroid;
-        cam_from_world.rotation =
-            RotationAbout(axis, options.pose_noise_deg * normal(random)) *
-            cam_from_world.rotation;
-        cam_from_world.translation =
-            centroid_in_cam - cam_from_world.rotation * centroid;
-        cam_from_world.translation.x() +=
-            options.pose_noise_translation * normal(random);
-        cam_from_world.translation.y() +=
-            options.pose_noise_translation * normal(random);
-      }
-      if (!missing) {
-        // The forward translation is unknown to a radial pose.
-        cam_from_world.translation.z() = 10 * normal(random);
-        result.localized = true;
-        result.single_image_cam_from_world = cam_from_world;
-        result.inlier_mask.assign(image.correspondences.size(), 1);
-        result.num_inliers = image.correspondences.size();
-      }
-      dataset.images.push_back(image);
-      scene.input.images.push_back(result);
-      scene.garbage.push_back(garbage);
+      AddImage(options, i, j, &random, &scene);
     }
   }
   return scene;
+}
+
+// The two-camera rig of RadialRigSceneOptions::pair, second camera turned by
+// yaw_deg, every frameset with both cameras; a share of mis-localized images.
+inline RadialRigScene MakePairScene(double yaw_deg, double garbage_ratio = 0) {
+  RadialRigSceneOptions options;
+  options.pair = true;
+  options.pair_yaw_deg = yaw_deg;
+  options.garbage_ratio = garbage_ratio;
+  options.min_cameras_per_frameset = 2;
+  options.max_cameras_per_frameset = 2;
+  return MakeRadialRigScene(options);
 }
 
 // Frobenius norm of the difference of two rotations: sqrt(2) times the angle
 // in radians for small angles, and accurate near zero, unlike acos.
 inline double RotationDistance(const Rigid3d& a, const Rigid3d& b) {
   return (a.RotationMatrix() - b.RotationMatrix()).norm();
+}
+
+// The truth in the radial gauge of the estimates (NormalizeRadialRigOrigin
+// about camera 0): its rotations and all radial projections are unchanged.
+inline RigCalibration RadialTruth(const RadialRigScene& scene) {
+  RigCalibration truth = scene.truth;
+  NormalizeRadialRigOrigin(scene.dataset.reference_camera, &truth);
+  return truth;
+}
+
+// Gives every localized image its true full pose (tz included): the input
+// of the full-pose (rd_ra, known*) rig initialization on exact data.
+inline void UseTrueFullPoses(RadialRigScene* scene) {
+  for (size_t k = 0; k < scene->dataset.images.size(); ++k) {
+    const RigImage& image = scene->dataset.images[k];
+    std::optional<Rigid3d>& pose =
+        scene->input.images[k].single_image_cam_from_world;
+    if (pose) {
+      pose =
+          scene->truth.CamFromWorld(image.camera_index, image.frameset_index);
+    }
+  }
+}
+
+// Every camera calibrated and every rig pose set, each within `tolerance`
+// of the truth: rotations in RotationDistance, translations in norm.
+inline void ExpectRigNear(const RigCalibration& estimate,
+                          const RigCalibration& truth, double tolerance) {
+  ASSERT_EQ(estimate.cam_from_rig.size(), truth.cam_from_rig.size());
+  ASSERT_EQ(estimate.rig_from_world.size(), truth.rig_from_world.size());
+  for (size_t i = 0; i < truth.cam_from_rig.size(); ++i) {
+    SCOPED_TRACE("camera " + std::to_string(i));
+    ASSERT_TRUE(estimate.camera_calibrated[i]);
+    EXPECT_LT(RotationDistance(estimate.cam_from_rig[i], truth.cam_from_rig[i]),
+              tolerance);
+    EXPECT_LT((estimate.cam_from_rig[i].translation -
+               truth.cam_from_rig[i].translation)
+                  .norm(),
+              tolerance);
+  }
+  for (size_t j = 0; j < truth.rig_from_world.size(); ++j) {
+    SCOPED_TRACE("frameset " + std::to_string(j));
+    ASSERT_TRUE(estimate.rig_from_world[j]);
+    EXPECT_LT(
+        RotationDistance(*estimate.rig_from_world[j], *truth.rig_from_world[j]),
+        tolerance);
+    EXPECT_LT((estimate.rig_from_world[j]->translation -
+               truth.rig_from_world[j]->translation)
+                  .norm(),
+              tolerance);
+  }
 }
 
 }  // namespace testing
