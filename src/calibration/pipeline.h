@@ -1,24 +1,15 @@
-// The calibration pipeline (paper §3) and the paper's baselines (§5.1) as
-// methods of one entry point (calibration_method.h):
-//
-//   1dr           Inf+1DR+RA (default): 1D radial pose per image, robust radial
-//                 rig initialization, radial BA with principal points, camera
-//                 upgrade over all frames of each camera, final BA.
-//   rd_ra         Inf+RD+RA: pose + intrinsics per image, robust rig
-//                 initialization on full poses, final BA.
-//   rd            Inf+RD: as rd_ra, but the rig is taken from the best complete
-//                 frameset (Heng et al.'s initialization).
-//   known         Inf+K: intrinsics given, full pose per image, the rig from
-//                 the best complete frameset (Heng et al.), final BA of
-//                 extrinsics and rig poses.
-//   known_refine  Inf+K+RI: as known, intrinsics refined in the final BA.
-//   known_ra      not in the paper: as known, with the robust rig
-//                 initialization of rd_ra.
+// The calibration pipeline (paper §3): one entry point for the paper's method
+// and its baselines (§5.1), which differ per stage as calibration_method.h
+// lists. The stages, in order (pipeline_stages.h): single-image localization
+// (initial_pose_estimation.h), rig initialization (rig_initializer.h or
+// complete_frameset_initialization.h), for 1dr the radial bundle adjustment
+// and the camera upgrade (radial_bundle_adjuster.h, camera_upgrader.h), and
+// the final bundle adjustment (final_bundle_adjuster.h).
 //
 // Problems the pipeline can work around are reported as diagnostics instead
-// of failures: e.g. a rig whose cameras all have parallel principal axes
-// cannot be initialized from radial poses (paper, Limitations) and 1dr then
-// falls back to rd_ra.
+// of failures (pipeline_report.h): e.g. a rig whose cameras all have parallel
+// or anti-parallel principal axes cannot be initialized from radial poses
+// (paper, Limitations; principal_axes.h) and 1dr then falls back to rd_ra.
 #pragma once
 
 #include <string>
