@@ -61,20 +61,19 @@ struct Scene {
   int num_observations = 0;  // rig observations expected in the model
 };
 
-Scene MakeScene() {
-  std::mt19937 random(5);
-  Scene scene;
+// The map of Scene; returns its points (ids 1, 2, ...).
+std::vector<Eigen::Vector3d> MakeMap(std::mt19937* random, Scene* scene) {
   colmap::Camera map_camera = MakeCamera("PINHOLE", {500, 500, 320, 240});
   map_camera.SetCameraId(1);
-  scene.map.AddCamera(map_camera);
+  scene->map.AddCamera(map_camera);
   std::uniform_real_distribution<double> uniform(-1, 1);
   std::vector<Eigen::Vector3d> points;
   for (int k = 0; k < kNumMapPoints; ++k) {
-    points.emplace_back(4 * uniform(random), 3 * uniform(random),
-                        10 + 3 * uniform(random));
+    points.emplace_back(4 * uniform(*random), 3 * uniform(*random),
+                        10 + 3 * uniform(*random));
   }
   for (colmap::image_t image_id : {1, 2}) {
-    const Rigid3d pose = SmallPose(&random, 0.05, 0.5);
+    const Rigid3d pose = SmallPose(random, 0.05, 0.5);
     colmap::Image image;
     image.SetImageId(image_id);
     image.SetName("map/" + std::to_string(image_id) + ".png");
@@ -86,18 +85,23 @@ Scene MakeScene() {
       points2D.push_back(Project(map_camera, pose, point));
     }
     image.SetPoints2D(points2D);
-    scene.map.AddImage(image);
-    scene.map.RegisterImage(image_id);
+    scene->map.AddImage(image);
+    scene->map.RegisterImage(image_id);
   }
   for (int k = 0; k < kNumMapPoints; ++k) {
     colmap::Track track;
     track.AddElement(1, k);
     track.AddElement(2, k);
-    scene.map.AddPoint3D(points[k], track);
+    scene->map.AddPoint3D(points[k], track);
   }
+  return points;
+}
 
-  RigDataset& dataset = scene.dataset;
-  RigCalibration& calibration = scene.calibration;
+// The rig, dataset and calibration of Scene.
+void MakeRig(const std::vector<Eigen::Vector3d>& points, std::mt19937* random,
+             Scene* scene) {
+  RigDataset& dataset = scene->dataset;
+  RigCalibration& calibration = scene->calibration;
   const std::vector<colmap::Camera> cameras = {
       MakeCamera("OPENCV_FISHEYE",
                  {300, 301, 320.5, 240.5, 0.02, -0.003, 1e-4, 0}),
@@ -109,14 +113,14 @@ Scene MakeScene() {
     camera.camera = MakeCamera("SIMPLE_RADIAL", {400, 320, 240, 0});
     dataset.cameras.push_back(camera);
     calibration.cameras.push_back(cameras[c]);
-    calibration.cam_from_rig.push_back(SmallPose(&random, 0.2, 0.3));
+    calibration.cam_from_rig.push_back(SmallPose(random, 0.2, 0.3));
     calibration.camera_calibrated.push_back(true);
   }
   dataset.reference_camera = 0;
   for (int f = 0; f < 4; ++f) {
     dataset.frameset_names.push_back(std::to_string(f) + ".png");
     calibration.rig_from_world.push_back(f == 3 ? std::optional<Rigid3d>()
-                                                : SmallPose(&random, 0.1, 1.0));
+                                                : SmallPose(random, 0.1, 1.0));
   }
   for (int f = 0; f < 4; ++f) {
     for (int c = 0; c < 3; ++c) {
@@ -151,13 +155,20 @@ Scene MakeScene() {
       result.rms_px = 0.5 + c;
       result.radial_rms_px = 0.25;
       if (result.used) {
-        ++scene.num_registered;
-        scene.num_observations += 16;
+        ++scene->num_registered;
+        scene->num_observations += 16;
       }
       dataset.images.push_back(image);
       calibration.images.push_back(result);
     }
   }
+}
+
+Scene MakeScene() {
+  std::mt19937 random(5);
+  Scene scene;
+  const std::vector<Eigen::Vector3d> points = MakeMap(&random, &scene);
+  MakeRig(points, &random, &scene);
   return scene;
 }
 
@@ -260,6 +271,130 @@ TEST(ModelWriter, BuildsTheModel) {
       1e-15);
 }
 
+// The files of the output folder, and nothing left next to it.
+void ExpectOutputFiles(const testing::ScopedTempDir& dir,
+                       const std::string& output,
+                       const std::string& extension) {
+  std::set<std::string> files;
+  for (const auto& entry : fs::directory_iterator(output)) {
+    files.insert(entry.path().filename().string());
+  }
+  EXPECT_EQ(files,
+            (std::set<std::string>{"cameras" + extension, "images" + extension,
+                                   "points3D" + extension, "rigs" + extension,
+                                   "frames" + extension, kRigConfigFile,
+                                   kRigBundleAdjusterConfigFile, kCamchainFile,
+                                   kSummaryFile, kCorrespondencesFile}));
+  // No temporary folder is left next to the output.
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()),
+                          fs::directory_iterator()),
+            1);
+}
+
+// The model of the output: map and rig images, map points, all observations
+// and the calibrated intrinsics.
+void ExpectModel(const colmap::Reconstruction& model, const Scene& scene) {
+  EXPECT_EQ(model.NumCameras(), 4u);
+  EXPECT_EQ(model.NumImages(), 2u + scene.num_registered);
+  EXPECT_EQ(model.NumRegImages(), 2u + scene.num_registered);
+  EXPECT_EQ(model.NumPoints3D(), static_cast<size_t>(kNumMapPoints));
+  EXPECT_EQ(NumObservations(model),
+            2u * kNumMapPoints + scene.num_observations);
+  EXPECT_EQ(model.Camera(3).ModelName(), "OPENCV");
+  EXPECT_EQ(model.Camera(3).Params(), scene.calibration.cameras[1].Params());
+}
+
+// rigs/frames: the map's trivial rig and the calibrated one, trivial map
+// frames and rig frames with ids after every image id.
+void ExpectRigsAndFrames(const colmap::Reconstruction& model,
+                         const ColmapRigsAndFrames& rigs_frames) {
+  ASSERT_EQ(rigs_frames.rigs.size(), 2u);
+  EXPECT_EQ(rigs_frames.rigs[0].rig_id, 1u);
+  EXPECT_EQ(rigs_frames.rigs[1].rig_id, 5u);
+  EXPECT_EQ(rigs_frames.rigs[1].ref_sensor.id, 2u);
+  ASSERT_EQ(rigs_frames.rigs[1].sensors.size(), 2u);
+  // Two trivial map frames (ids = image ids) and three rig frames, with ids
+  // after every image id (the largest is 11).
+  ASSERT_EQ(rigs_frames.frames.size(), 5u);
+  EXPECT_EQ(rigs_frames.frames[0].frame_id, 1u);
+  EXPECT_EQ(rigs_frames.frames[1].frame_id, 2u);
+  for (int f = 2; f < 5; ++f) {
+    EXPECT_EQ(rigs_frames.frames[f].frame_id, 12u + (f - 2));
+  }
+  ExpectFramesMatchImages(model, rigs_frames);
+}
+
+// The exact text of COLMAP >= 3.12: trivial rig and frame lines, single
+// spaces, no trailing space.
+void ExpectRigsAndFramesText(const std::string& output) {
+  const std::string rigs = testing::ReadBytes(output + "/rigs.txt");
+  EXPECT_NE(rigs.find("# Number of rigs: 2\n1 1 CAMERA 1\n5 3 CAMERA 2 "
+                      "CAMERA 3 1 "),
+            std::string::npos)
+      << rigs;
+  const std::string frames = testing::ReadBytes(output + "/frames.txt");
+  std::istringstream lines(frames);
+  std::string line;
+  int num_data_lines = 0;
+  while (std::getline(lines, line)) {
+    if (line[0] == '#') continue;
+    ++num_data_lines;
+    EXPECT_EQ(line.find("  "), std::string::npos) << line;
+    EXPECT_NE(line.back(), ' ') << line;
+  }
+  EXPECT_EQ(num_data_lines, 5);
+  EXPECT_NE(frames.find("\n1 1 "), std::string::npos);
+  EXPECT_NE(frames.find(" 1 CAMERA 1 1\n"), std::string::npos);
+  EXPECT_NE(frames.find(" 2 CAMERA 2 6 CAMERA 3 7\n"), std::string::npos)
+      << frames;  // frameset 1 without its unused cam2 image (id 8)
+}
+
+// The exchange formats describe the same rig as rigs.*.
+void ExpectExchangeFormatsAgree(const std::string& output,
+                                const ColmapRigsAndFrames& rigs_frames) {
+  ASSERT_EQ(rigs_frames.rigs.size(), 2u);
+  ASSERT_EQ(rigs_frames.rigs[1].sensors.size(), 2u);
+  std::string error;
+  std::vector<RigDescription> rig_config;
+  ASSERT_TRUE(
+      ReadRigConfigJson(output + "/" + kRigConfigFile, &rig_config, &error))
+      << error;
+  RigDescription camchain;
+  ASSERT_TRUE(ReadCamchainYaml(output + "/" + kCamchainFile, &camchain, &error))
+      << error;
+  ASSERT_EQ(rig_config.size(), 1u);
+  ASSERT_EQ(camchain.cameras.size(), 3u);
+  const ColmapRig& rig = rigs_frames.rigs[1];
+  for (int c = 1; c < 3; ++c) {
+    const Rigid3d& sensor_from_rig = *rig.sensors[c - 1].sensor_from_rig;
+    EXPECT_LT((rig_config[0].cameras[c].cam_from_rig->ToMatrix() -
+               sensor_from_rig.ToMatrix())
+                  .norm(),
+              1e-12);
+    EXPECT_LT((camchain.cameras[c].cam_from_rig->ToMatrix() -
+               sensor_from_rig.ToMatrix())
+                  .norm(),
+              1e-12);
+  }
+}
+
+void ExpectSummary(const std::string& output) {
+  std::ifstream summary_file(output + "/" + kSummaryFile);
+  const nlohmann::json json = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(json["method"], "1dr");
+  EXPECT_EQ(json["num_framesets"], 4);
+  EXPECT_EQ(json["num_framesets_used"], 3);
+  ASSERT_EQ(json["cameras"].size(), 3u);
+  EXPECT_EQ(json["cameras"][2]["num_images"], 4);
+  EXPECT_EQ(json["cameras"][2]["num_used"], 2);
+  EXPECT_EQ(json["cameras"][2]["num_inliers"], 32);
+  EXPECT_DOUBLE_EQ(json["cameras"][2]["rms_px"].get<double>(), 2.5);
+  EXPECT_EQ(json["cameras"][1]["model"], "OPENCV");
+  EXPECT_EQ(json["cameras"][0]["cam_from_rig"]["rotation_wxyz"][0], 1.0);
+  EXPECT_EQ(json["diagnostics"][0], "a diagnostic of the caller");
+  EXPECT_EQ(json["timings_s"]["localize"], 1.5);
+}
+
 class ModelWriterOutput : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
@@ -282,118 +417,39 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
                              &error))
       << error;
 
-  const std::string extension = binary ? ".bin" : ".txt";
-  std::set<std::string> files;
-  for (const auto& entry : fs::directory_iterator(output)) {
-    files.insert(entry.path().filename().string());
-  }
-  EXPECT_EQ(files,
-            (std::set<std::string>{"cameras" + extension, "images" + extension,
-                                   "points3D" + extension, "rigs" + extension,
-                                   "frames" + extension, kRigConfigFile,
-                                   kRigBundleAdjusterConfigFile, kCamchainFile,
-                                   kSummaryFile, kCorrespondencesFile}));
-  // No temporary folder is left next to the output.
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()),
-                          fs::directory_iterator()),
-            1);
-
+  ExpectOutputFiles(dir, output, binary ? ".bin" : ".txt");
   colmap::Reconstruction model;
   model.Read(output);
-  EXPECT_EQ(model.NumCameras(), 4u);
-  EXPECT_EQ(model.NumImages(), 2u + scene.num_registered);
-  EXPECT_EQ(model.NumRegImages(), 2u + scene.num_registered);
-  EXPECT_EQ(model.NumPoints3D(), static_cast<size_t>(kNumMapPoints));
-  EXPECT_EQ(NumObservations(model),
-            2u * kNumMapPoints + scene.num_observations);
-  EXPECT_EQ(model.Camera(3).ModelName(), "OPENCV");
-  EXPECT_EQ(model.Camera(3).Params(), scene.calibration.cameras[1].Params());
-
+  ExpectModel(model, scene);
   ColmapRigsAndFrames rigs_frames;
   ASSERT_TRUE(ReadRigsAndFrames(output, &rigs_frames, &error)) << error;
-  ASSERT_EQ(rigs_frames.rigs.size(), 2u);
-  EXPECT_EQ(rigs_frames.rigs[0].rig_id, 1u);
-  EXPECT_EQ(rigs_frames.rigs[1].rig_id, 5u);
-  EXPECT_EQ(rigs_frames.rigs[1].ref_sensor.id, 2u);
-  ASSERT_EQ(rigs_frames.rigs[1].sensors.size(), 2u);
-  // Two trivial map frames (ids = image ids) and three rig frames, with ids
-  // after every image id (the largest is 11).
-  ASSERT_EQ(rigs_frames.frames.size(), 5u);
-  EXPECT_EQ(rigs_frames.frames[0].frame_id, 1u);
-  EXPECT_EQ(rigs_frames.frames[1].frame_id, 2u);
-  for (int f = 2; f < 5; ++f) {
-    EXPECT_EQ(rigs_frames.frames[f].frame_id, 12u + (f - 2));
-  }
-  ExpectFramesMatchImages(model, rigs_frames);
-
-  if (!binary) {
-    // The exact text of COLMAP >= 3.12: trivial rig and frame lines, single
-    // spaces, no trailing space.
-    const std::string rigs = testing::ReadBytes(output + "/rigs.txt");
-    EXPECT_NE(rigs.find("# Number of rigs: 2\n1 1 CAMERA 1\n5 3 CAMERA 2 "
-                        "CAMERA 3 1 "),
-              std::string::npos)
-        << rigs;
-    const std::string frames = testing::ReadBytes(output + "/frames.txt");
-    std::istringstream lines(frames);
-    std::string line;
-    int num_data_lines = 0;
-    while (std::getline(lines, line)) {
-      if (line[0] == '#') continue;
-      ++num_data_lines;
-      EXPECT_EQ(line.find("  "), std::string::npos) << line;
-      EXPECT_NE(line.back(), ' ') << line;
-    }
-    EXPECT_EQ(num_data_lines, 5);
-    EXPECT_NE(frames.find("\n1 1 "), std::string::npos);
-    EXPECT_NE(frames.find(" 1 CAMERA 1 1\n"), std::string::npos);
-    EXPECT_NE(frames.find(" 2 CAMERA 2 6 CAMERA 3 7\n"), std::string::npos)
-        << frames;  // frameset 1 without its unused cam2 image (id 8)
-  }
-
-  // The exchange formats describe the same rig.
-  std::vector<RigDescription> rig_config;
-  ASSERT_TRUE(
-      ReadRigConfigJson(output + "/" + kRigConfigFile, &rig_config, &error))
-      << error;
-  RigDescription camchain;
-  ASSERT_TRUE(ReadCamchainYaml(output + "/" + kCamchainFile, &camchain, &error))
-      << error;
-  ASSERT_EQ(rig_config.size(), 1u);
-  ASSERT_EQ(camchain.cameras.size(), 3u);
-  const ColmapRig& rig = rigs_frames.rigs[1];
-  for (int c = 1; c < 3; ++c) {
-    const Rigid3d& sensor_from_rig = *rig.sensors[c - 1].sensor_from_rig;
-    EXPECT_LT((rig_config[0].cameras[c].cam_from_rig->ToMatrix() -
-               sensor_from_rig.ToMatrix())
-                  .norm(),
-              1e-12);
-    EXPECT_LT((camchain.cameras[c].cam_from_rig->ToMatrix() -
-               sensor_from_rig.ToMatrix())
-                  .norm(),
-              1e-12);
-  }
-
-  std::ifstream summary_file(output + "/" + kSummaryFile);
-  const nlohmann::json json = nlohmann::json::parse(summary_file);
-  EXPECT_EQ(json["method"], "1dr");
-  EXPECT_EQ(json["num_framesets"], 4);
-  EXPECT_EQ(json["num_framesets_used"], 3);
-  ASSERT_EQ(json["cameras"].size(), 3u);
-  EXPECT_EQ(json["cameras"][2]["num_images"], 4);
-  EXPECT_EQ(json["cameras"][2]["num_used"], 2);
-  EXPECT_EQ(json["cameras"][2]["num_inliers"], 32);
-  EXPECT_DOUBLE_EQ(json["cameras"][2]["rms_px"].get<double>(), 2.5);
-  EXPECT_EQ(json["cameras"][1]["model"], "OPENCV");
-  EXPECT_EQ(json["cameras"][0]["cam_from_rig"]["rotation_wxyz"][0], 1.0);
-  EXPECT_EQ(json["diagnostics"][0], "a diagnostic of the caller");
-  EXPECT_EQ(json["timings_s"]["localize"], 1.5);
-
+  ExpectRigsAndFrames(model, rigs_frames);
+  if (!binary) ExpectRigsAndFramesText(output);
+  ExpectExchangeFormatsAgree(output, rigs_frames);
+  ExpectSummary(output);
   std::vector<ImageCorrespondences> correspondences;
   ASSERT_TRUE(ReadCorrespondenceFile(output + "/" + kCorrespondencesFile,
                                      &correspondences, &error))
       << error;
-  EXPECT_EQ(correspondences.size(), scene.dataset.images.size());
+  // Every image with every correspondence, bit for bit (a re-run from the
+  // file must see the same input).
+  ASSERT_EQ(correspondences.size(), scene.dataset.images.size());
+  for (size_t i = 0; i < correspondences.size(); ++i) {
+    const RigImage& image = scene.dataset.images[i];
+    EXPECT_EQ(correspondences[i].image_name, image.name);
+    const colmap::Camera& camera =
+        scene.dataset.cameras[image.camera_index].camera;
+    EXPECT_EQ(correspondences[i].width, static_cast<int>(camera.Width()));
+    EXPECT_EQ(correspondences[i].height, static_cast<int>(camera.Height()));
+    ASSERT_EQ(correspondences[i].correspondences.size(),
+              image.correspondences.size());
+    for (size_t k = 0; k < image.correspondences.size(); ++k) {
+      const Correspondence& read = correspondences[i].correspondences[k];
+      EXPECT_EQ(read.point2D, image.correspondences[k].point2D);
+      EXPECT_EQ(read.point3D, image.correspondences[k].point3D);
+      EXPECT_EQ(read.point3D_id, image.correspondences[k].point3D_id);
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(BinAndTxt, ModelWriterOutput,
