@@ -22,6 +22,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
+class MapLocalizerRetrievalTest : public testing::MapLocalizerTest {
+ protected:
+  // Retrieval finds the planted correspondences, matching each rig image to
+  // no more than the retrieved map images.
+  void ExpectRetrievalRecoversPlanted(const MapLocalizerOptions& options) {
+    const std::vector<ImageLocalization> results = LocalizeAll(options);
+    ExpectPlantedRecovered(results, CorrespondenceSource::kImageMatching);
+    for (const ImageLocalization& result : results) {
+      EXPECT_LE(result.num_map_images_matched, options.num_retrieved_images);
+    }
+  }
+};
+
 using testing::MapLocalizerTest;
 
 TEST_F(MapLocalizerTest, DirectIndexRecoversPlantedCorrespondences) {
@@ -44,19 +57,15 @@ TEST_F(MapLocalizerTest, RetrievalOfAllMapImagesRecoversPlanted) {
   }
 }
 
-TEST_F(MapLocalizerTest, RetrievalByDirectVotesRecoversPlanted) {
+TEST_F(MapLocalizerRetrievalTest, ByDirectVotesRecoversPlanted) {
   MapLocalizerOptions options;
   options.mode = LocalizationMode::kRetrieval;
   options.max_num_map_images_exhaustive = 5;
   options.num_retrieved_images = 8;
-  const std::vector<ImageLocalization> results = LocalizeAll(options);
-  ExpectPlantedRecovered(results, CorrespondenceSource::kImageMatching);
-  for (const ImageLocalization& result : results) {
-    EXPECT_LE(result.num_map_images_matched, 8);
-  }
+  ExpectRetrievalRecoversPlanted(options);
 }
 
-TEST_F(MapLocalizerTest, RetrievalByVocabularyTreeRecoversPlanted) {
+TEST_F(MapLocalizerRetrievalTest, ByVocabularyTreeRecoversPlanted) {
   colmap::retrieval::VisualIndex<> tree;
   colmap::retrieval::VisualIndex<>::BuildOptions build_options;
   build_options.num_visual_words = 256;
@@ -71,11 +80,7 @@ TEST_F(MapLocalizerTest, RetrievalByVocabularyTreeRecoversPlanted) {
   options.mode = LocalizationMode::kRetrieval;
   options.vocab_tree_path = tree_path;
   options.num_retrieved_images = 8;
-  const std::vector<ImageLocalization> results = LocalizeAll(options);
-  ExpectPlantedRecovered(results, CorrespondenceSource::kImageMatching);
-  for (const ImageLocalization& result : results) {
-    EXPECT_LE(result.num_map_images_matched, 8);
-  }
+  ExpectRetrievalRecoversPlanted(options);
 }
 
 TEST_F(MapLocalizerTest, UsesVerifiedMatchesStoredInTheDatabase) {
