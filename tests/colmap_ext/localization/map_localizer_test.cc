@@ -248,6 +248,22 @@ TEST_F(MapLocalizerTest, ReportsMapsItCannotUse) {
   EXPECT_NE(error.find("use_gpu"), std::string::npos) << error;
 }
 
+// Every mode's name reads back as the mode.
+TEST(LocalizationModeTest, NamesRoundTrip) {
+  for (const LocalizationMode mode :
+       {LocalizationMode::kDirect, LocalizationMode::kRetrieval}) {
+    LocalizationMode read = mode == LocalizationMode::kDirect
+                                ? LocalizationMode::kRetrieval
+                                : LocalizationMode::kDirect;
+    ASSERT_TRUE(LocalizationModeFromName(LocalizationModeName(mode), &read));
+    EXPECT_EQ(read, mode);
+  }
+  EXPECT_EQ(LocalizationModeName(LocalizationMode::kDirect), "direct");
+  EXPECT_EQ(LocalizationModeName(LocalizationMode::kRetrieval), "retrieval");
+  LocalizationMode mode;
+  EXPECT_FALSE(LocalizationModeFromName("exhaustive", &mode));
+}
+
 TEST(SelectOneToOneCorrespondencesTest, KeepsTheBestSupportedPairs) {
   // Keypoint 1 -> point 10 twice (2 votes) beats 1 -> 11; keypoint 2 -> 10
   // loses point 10 to keypoint 1 and keeps 12; keypoints 3 and 4 both want
