@@ -24,10 +24,7 @@ log_tag=benchmark_runtime
 # shellcheck source=common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
-if [[ $# -lt 1 || "$1" == "-h" || "$1" == "--help" ]]; then
-  usage >&2
-  exit 2
-fi
+check_arguments 1 "" "$@"
 results="$1"
 shift
 

@@ -34,10 +34,7 @@ log_tag=build_map
 # shellcheck source=common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
-if [[ $# -lt 2 || $# -gt 4 || "$1" == "-h" || "$1" == "--help" ]]; then
-  usage >&2
-  exit 2
-fi
+check_arguments 2 4 "$@"
 images_dir="$1"
 work_dir="$2"
 ref_positions="${3:-}"

@@ -25,10 +25,7 @@ log_tag=calibrate_rig
 # shellcheck source=common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
-if [[ $# -lt 4 || "$1" == "-h" || "$1" == "--help" ]]; then
-  usage >&2
-  exit 2
-fi
+check_arguments 4 "" "$@"
 map_db="$1"
 map_model="$2"
 rig_images="$3"

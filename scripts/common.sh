@@ -13,6 +13,18 @@ usage() {
   sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'
 }
 
+# check_arguments MIN MAX "$@": prints the usage and exits 2 for -h/--help or
+# fewer than MIN or more than MAX arguments (MAX empty: no limit).
+check_arguments() {
+  local min="$1" max="$2"
+  shift 2
+  if [[ $# -lt $min || (-n "$max" && $# -gt $max) || "${1:-}" == "-h" ||
+    "${1:-}" == "--help" ]]; then
+    usage >&2
+    exit 2
+  fi
+}
+
 # run_step NAME COMMAND...: runs a step (dies if it fails) and records its
 # wall time in `timings`, the name padded to step_name_width characters.
 step_name_width=40

@@ -47,10 +47,7 @@ diagnostic="${EUROC_DIAGNOSTIC:-1}"
 tools="$repo/scripts/euroc_tools.py"
 marker=".euroc_check_output"
 
-if [[ $# -gt 1 || "${1:-}" == "-h" || "${1:-}" == "--help" ]]; then
-  usage >&2
-  exit 2
-fi
+check_arguments 0 1 "$@"
 [[ "$map_every" =~ ^[1-9][0-9]*$ ]] || die "EUROC_MAP_EVERY must be a positive integer, got '$map_every'"
 for camera in cam0 cam1; do
   [[ -f "$data/mav0/$camera/sensor.yaml" && -d "$data/mav0/$camera/data" ]] ||

@@ -279,16 +279,15 @@ std::string LocalizationRuntimeCsv(
          "localization CPU s,images per s,CPU s per image,recall,precision,"
          "radial pose s per image,poses correct,peak memory MB\n";
   for (const LocalizationRuntime& run : runs) {
-    const double per_image =
-        run.num_images > 0 ? run.cpu_seconds / run.num_images : std::nan("");
     csv << run.mode << "," << run.num_map_images << "," << run.num_map_points
         << "," << run.num_indexed_descriptors << ","
         << run.features_per_rig_image << "," << run.num_checks << ","
         << run.num_images << "," << Fixed(run.index_seconds, 3) << ","
         << Fixed(run.index_cpu_seconds, 3) << "," << Fixed(run.seconds, 3)
         << "," << Fixed(run.cpu_seconds, 3) << ","
-        << Fixed(run.ImagesPerSecond(), 2) << "," << Fixed(per_image, 4) << ","
-        << Fixed(run.recall, 4) << "," << Fixed(run.precision, 4) << ","
+        << Fixed(run.ImagesPerSecond(), 2) << ","
+        << Fixed(run.CpuSecondsPerImage(), 4) << "," << Fixed(run.recall, 4)
+        << "," << Fixed(run.precision, 4) << ","
         << Fixed(run.radial_pose_seconds_per_image, 5) << ","
         << run.num_poses_correct << "," << Fixed(run.peak_memory_mb, 1) << "\n";
   }
@@ -370,14 +369,12 @@ std::string LocalizationRuntimeMarkdown(
         "within 0.5 deg | peak memory MB |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const LocalizationRuntime& run : runs) {
-    const double per_image =
-        run.num_images > 0 ? run.cpu_seconds / run.num_images : std::nan("");
     md << "| " << run.mode << " | " << run.num_map_images << " | "
        << run.num_map_points << " | " << run.features_per_rig_image << " | "
        << (run.mode == "direct" ? std::to_string(run.num_checks) : "-") << " | "
        << run.num_images << " | " << Fixed(run.index_seconds, 2) << " ("
        << Fixed(run.index_cpu_seconds, 2) << ") | "
-       << Fixed(run.ImagesPerSecond(), 2) << " | " << Fixed(per_image, 3)
+       << Fixed(run.ImagesPerSecond(), 2) << " | " << Fixed(run.CpuSecondsPerImage(), 3)
        << " | " << Fixed(run.recall, 3) << " | " << Fixed(run.precision, 3)
        << " | " << Fixed(1000 * run.radial_pose_seconds_per_image, 2) << " | "
        << run.num_poses_correct << "/" << run.num_images << " | "

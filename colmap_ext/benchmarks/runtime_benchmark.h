@@ -9,6 +9,7 @@
 // grows when other work shares the machine, CPU time hardly does.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,10 @@ struct LocalizationRuntime {
 
   double ImagesPerSecond() const {
     return seconds > 0 ? num_images / seconds : 0;
+  }
+  // All threads' CPU seconds of LocalizeImages per image; NaN without images.
+  double CpuSecondsPerImage() const {
+    return num_images > 0 ? cpu_seconds / num_images : std::nan("");
   }
 };
 

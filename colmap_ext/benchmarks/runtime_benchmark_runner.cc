@@ -223,8 +223,7 @@ std::vector<LocalizationRuntime> RunLocalizations(
               << " features per rig image, " << request.num_checks
               << " checks: " << std::setprecision(2)
               << runtime.ImagesPerSecond() << " images/s, "
-              << std::setprecision(3)
-              << runtime.cpu_seconds / std::max(1, runtime.num_images)
+              << std::setprecision(3) << runtime.CpuSecondsPerImage()
               << " CPU s per image, index " << Seconds(runtime.index_seconds)
               << " s, recall " << runtime.recall << ", precision "
               << runtime.precision << std::endl;

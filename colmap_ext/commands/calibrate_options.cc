@@ -33,7 +33,11 @@ void AddInputOutputOptions(po::options_description* description,
 void AddRigCalibratorOptions(po::options_description* description,
                              CalibrateOptions* o) {
   AddOption(description, "RigCalibrator.method", &o->method,
-            "1dr (default, Inf+1DR+RA), rd_ra, rd, known, known_refine");
+            "1dr (default, Inf+1DR+RA), rd_ra (Inf+RD+RA), rd (Inf+RD), "
+            "known (Inf+K), known_refine (Inf+K+RI), known_ra (given "
+            "intrinsics, robust rig initialization); rd, known and "
+            "known_refine need a frameset in which every camera is "
+            "localized");
   AddOption(description, "RigCalibrator.camera_model", &o->camera_model,
             "COLMAP camera model of every camera (e.g. OPENCV, "
             "OPENCV_FISHEYE, FULL_OPENCV, RADIAL), or per camera: "
@@ -141,7 +145,7 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
   if (!CalibrationMethodFromName(options->method, &pipeline->method)) {
     *error =
         "--RigCalibrator.method must be one of 1dr, rd_ra, rd, known, "
-        "known_refine, not " +
+        "known_refine, known_ra, not " +
         options->method;
     return false;
   }

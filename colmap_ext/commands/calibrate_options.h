@@ -8,6 +8,7 @@
 #include <string>
 
 #include "colmap_ext/localization/map_localizer.h"
+#include "src/calibration/calibration_method.h"
 #include "src/calibration/pipeline.h"
 
 namespace rig_calibrator {
@@ -49,9 +50,12 @@ struct CalibrateOptions {
   colmap::SiftMatchingOptions sift_matching;
 
   bool FromCorrespondences() const { return !correspondences_path.empty(); }
-  // The known* methods, which take the intrinsics as given.
+  // The known* methods (known, known_refine, known_ra), which take the
+  // intrinsics as given.
   bool KnownIntrinsics() const {
-    return method == "known" || method == "known_refine";
+    CalibrationMethod value;
+    return CalibrationMethodFromName(method, &value) &&
+           UsesKnownIntrinsics(value);
   }
 };
 

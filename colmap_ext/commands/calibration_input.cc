@@ -188,9 +188,9 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
   return true;
 }
 
-// The known* methods: intrinsics from --RigCalibrator.intrinsics_path, else
-// from the database cameras of the rig images (as set by
-// feature_extractor --ImageReader.camera_params).
+// The known* methods (known, known_refine, known_ra): intrinsics from
+// --RigCalibrator.intrinsics_path, else from the database cameras of the rig
+// images (as set by feature_extractor --ImageReader.camera_params).
 bool SetKnownIntrinsics(const CalibrateOptions& options,
                         const std::vector<colmap::Camera>& database_cameras,
                         RigDataset* dataset, std::string* error) {

@@ -1,10 +1,10 @@
 #include "colmap_ext/commands/render_command.h"
 
 #include <colmap/base/reconstruction.h>
+#include <colmap/util/timer.h>
 
 #include <boost/filesystem.hpp>
 #include <boost/program_options.hpp>
-#include <chrono>
 #include <iostream>
 #include <sstream>
 
@@ -18,11 +18,6 @@ namespace rig_calibrator {
 namespace {
 
 namespace fs = boost::filesystem;
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 std::string PoseText(const Rigid3d& pose) {
   const Eigen::Vector4d q = pose.Qvec();
@@ -80,11 +75,9 @@ bool WritePoseModel(const fs::path& folder,
   return true;
 }
 
-bool WriteGroundTruth(const RenderedDatasetOptions& options,
-                      const RenderedDatasetPlan& plan,
-                      const RenderOptions& render_options,
-                      const fs::path& folder, std::string* error) {
-  if (!MakeFolder(folder, error)) return false;
+// The map's true camera, image positions and poses.
+bool WriteMapGroundTruth(const RenderedDatasetPlan& plan,
+                         const fs::path& folder, std::string* error) {
   const colmap::Camera& map_camera = plan.map_camera;
   if (!WriteFileAtomically(
           (folder / "map_camera.txt").string(),
@@ -107,12 +100,15 @@ bool WriteGroundTruth(const RenderedDatasetOptions& options,
                            positions, error)) {
     return false;
   }
-  if (!WritePoseModel(folder / "map_model", {map_camera}, plan.map_image_names,
-                      std::vector<int>(plan.map_image_names.size(), 0),
-                      plan.map_cam_from_world, error)) {
-    return false;
-  }
+  return WritePoseModel(folder / "map_model", {map_camera},
+                        plan.map_image_names,
+                        std::vector<int>(plan.map_image_names.size(), 0),
+                        plan.map_cam_from_world, error);
+}
 
+// The rig: its poses per frameset, rig_config.json and the rig images' poses.
+bool WriteRigGroundTruth(const RenderedDatasetPlan& plan,
+                         const fs::path& folder, std::string* error) {
   const int num_cameras = static_cast<int>(plan.rig.cameras.size());
   std::vector<colmap::Camera> rig_cameras = plan.rig.cameras;
   std::vector<std::string> rig_names;
@@ -141,14 +137,23 @@ bool WriteGroundTruth(const RenderedDatasetOptions& options,
                                    plan.rig.rig_from_world[f]);
     }
   }
-  if (!WriteFileAtomically((folder / "rig_from_world.txt").string(), rig_poses,
-                           error) ||
-      !WriteRigConfigJson((folder / "rig_config.json").string(), rig, error) ||
-      !WritePoseModel(folder / "rig_model", rig_cameras, rig_names,
-                      rig_camera_indices, rig_cam_from_world, error)) {
+  return WriteFileAtomically((folder / "rig_from_world.txt").string(),
+                             rig_poses, error) &&
+         WriteRigConfigJson((folder / "rig_config.json").string(), rig,
+                            error) &&
+         WritePoseModel(folder / "rig_model", rig_cameras, rig_names,
+                        rig_camera_indices, rig_cam_from_world, error);
+}
+
+bool WriteGroundTruth(const RenderedDatasetOptions& options,
+                      const RenderedDatasetPlan& plan,
+                      const RenderOptions& render_options,
+                      const fs::path& folder, std::string* error) {
+  if (!MakeFolder(folder, error) || !WriteMapGroundTruth(plan, folder, error) ||
+      !WriteRigGroundTruth(plan, folder, error)) {
     return false;
   }
-
+  const int num_cameras = static_cast<int>(plan.rig.cameras.size());
   // In the form of rig_calibrator's --RigCalibrator.camera_model.
   std::string camera_models;
   for (int c = 0; c < num_cameras; ++c) {
@@ -199,7 +204,8 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
   folder_options.overwrite = overwrite;
   auto write = [&](const std::string& folder_path, std::string* error) {
     const fs::path folder(folder_path);
-    const auto start = std::chrono::steady_clock::now();
+    colmap::Timer timer;
+    timer.Start();
     // Noise seeds: distinct per image, derived from the dataset seed.
     const uint64_t seed_base =
         (static_cast<uint64_t>(dataset_options.seed) << 32);
@@ -213,13 +219,13 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
         return false;
       }
     }
-    const double map_seconds = SecondsSince(start);
+    const double map_seconds = timer.ElapsedSeconds();
     std::cout << "Rendered " << plan.map_image_names.size() << " map images in "
               << map_seconds << " s ("
               << map_seconds / plan.map_image_names.size() << " s per image)"
               << std::endl;
 
-    const auto rig_start = std::chrono::steady_clock::now();
+    timer.Restart();
     const int num_framesets = static_cast<int>(plan.frameset_names.size());
     for (size_t c = 0; c < plan.rig.cameras.size(); ++c) {
       const fs::path camera_folder =
@@ -243,7 +249,7 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
         }
       }
     }
-    const double rig_seconds = SecondsSince(rig_start);
+    const double rig_seconds = timer.ElapsedSeconds();
     const size_t num_rig_images = plan.rig.cameras.size() * num_framesets;
     std::cout << "Rendered " << num_rig_images << " rig images in "
               << rig_seconds << " s (" << rig_seconds / num_rig_images

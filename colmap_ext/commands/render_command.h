@@ -1,5 +1,6 @@
 // `rig_calibrator render`: renders a rig dataset with exact ground truth
-// (src/synthetic/rendered_dataset.h, src/synthetic/scene_renderer.h) into a folder:
+// (src/synthetic/rendered_dataset.h, src/synthetic/scene_renderer.h) into a
+// folder:
 //
 //   map_images/map_000000.png ...   the mapping sequence (a PINHOLE camera)
 //   rig_images/cam0/000000.png ...  one folder per rig camera, one file name

@@ -88,16 +88,20 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents,
   return true;
 }
 
-bool WriteFolderAtomically(
-    const std::string& output_path, const OutputFolderOptions& options,
-    const std::function<bool(const std::string& folder, std::string* error)>&
-        write_contents,
-    std::string* error) {
-  if (output_path.empty()) {
-    *error = "the output path is empty";
-    return false;
-  }
-  const fs::path output = Normalized(output_path);
+namespace {
+
+void RemoveFolder(const fs::path& folder) {
+  std::error_code ignored;
+  fs::remove_all(folder, ignored);
+}
+
+// The output may not overlap an input, must be a folder that is empty (or
+// overwrite is set) or not exist, in an existing folder.
+bool CheckOutputFolder(const std::string& output_path,
+                       const OutputFolderOptions& options, fs::path* normalized,
+                       bool* exists, std::string* error) {
+  *normalized = Normalized(output_path);
+  const fs::path& output = *normalized;
   for (const std::string& input_path : options.input_paths) {
     if (input_path.empty()) continue;
     const fs::path input = Normalized(input_path);
@@ -109,8 +113,8 @@ bool WriteFolderAtomically(
   }
 
   std::error_code code;
-  const bool output_exists = fs::exists(output, code);
-  if (output_exists) {
+  *exists = fs::exists(output, code);
+  if (*exists) {
     if (!fs::is_directory(output, code)) {
       *error = "the output path " + output_path + " exists and is not a folder";
       return false;
@@ -127,29 +131,15 @@ bool WriteFolderAtomically(
              " that should contain the output does not exist";
     return false;
   }
+  return true;
+}
 
-  const fs::path temporary = TemporarySibling(output, "tmp");
-  if (!fs::create_directory(temporary, code) || code) {
-    *error = "cannot create the folder " + temporary.string() + ": " +
-             code.message();
-    return false;
-  }
-  auto discard = [&temporary]() {
-    std::error_code ignored;
-    fs::remove_all(temporary, ignored);
-  };
-  bool written = false;
-  try {
-    written = write_contents(temporary.string(), error);
-  } catch (...) {
-    discard();
-    throw;
-  }
-  if (!written) {
-    discard();
-    return false;
-  }
-
+// Moves the written `temporary` folder to `output`; on failure removes it
+// and restores the old output.
+bool ReplaceOutputFolder(const fs::path& temporary, const fs::path& output,
+                         const std::string& output_path, bool output_exists,
+                         std::string* error) {
+  std::error_code code;
   // An empty folder in the way is replaced by the rename itself (POSIX); a
   // non-empty one (with overwrite) is first moved aside and removed once the
   // new folder is in place, or moved back if that fails.
@@ -160,7 +150,7 @@ bool WriteFolderAtomically(
     if (code) {
       *error = "cannot move the old output folder " + output_path +
                " aside: " + code.message();
-      discard();
+      RemoveFolder(temporary);
       return false;
     }
   }
@@ -168,18 +158,54 @@ bool WriteFolderAtomically(
   if (code) {
     *error = "cannot rename " + temporary.string() + " to " + output_path +
              ": " + code.message();
-    discard();
+    RemoveFolder(temporary);
     if (!old_output.empty()) {
       std::error_code ignored;
       fs::rename(old_output, output, ignored);
     }
     return false;
   }
-  if (!old_output.empty()) {
-    std::error_code ignored;
-    fs::remove_all(old_output, ignored);
-  }
+  if (!old_output.empty()) RemoveFolder(old_output);
   return true;
+}
+
+}  // namespace
+
+bool WriteFolderAtomically(
+    const std::string& output_path, const OutputFolderOptions& options,
+    const std::function<bool(const std::string& folder, std::string* error)>&
+        write_contents,
+    std::string* error) {
+  if (output_path.empty()) {
+    *error = "the output path is empty";
+    return false;
+  }
+  fs::path output;
+  bool output_exists = false;
+  if (!CheckOutputFolder(output_path, options, &output, &output_exists,
+                         error)) {
+    return false;
+  }
+  std::error_code code;
+  const fs::path temporary = TemporarySibling(output, "tmp");
+  if (!fs::create_directory(temporary, code) || code) {
+    *error = "cannot create the folder " + temporary.string() + ": " +
+             code.message();
+    return false;
+  }
+  bool written = false;
+  try {
+    written = write_contents(temporary.string(), error);
+  } catch (...) {
+    RemoveFolder(temporary);
+    throw;
+  }
+  if (!written) {
+    RemoveFolder(temporary);
+    return false;
+  }
+  return ReplaceOutputFolder(temporary, output, output_path, output_exists,
+                             error);
 }
 
 }  // namespace rig_calibrator

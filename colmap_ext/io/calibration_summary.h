@@ -32,7 +32,8 @@ struct CameraSummary {
 };
 
 struct CalibrationSummary {
-  std::string method;  // "1dr", "rd_ra", "rd", "known", "known_refine"
+  // "1dr", "rd_ra", "rd", "known", "known_refine", "known_ra"
+  std::string method;
   // The map's units; a calibration is metric only if the map is.
   std::string units = "map units";
   std::optional<bool> map_looks_metric;  // unknown when not assessed
@@ -48,7 +49,7 @@ struct CalibrationSummary {
 // sets method, units, map_looks_metric, diagnostics and timings. Camera names
 // come from the dataset, image prefixes from `image_prefixes` (one per camera,
 // or empty for name + "/"). cam_from_rig is relative to the reference camera.
-// Requires CheckCalibrationMatchesDataset (rig_description.h).
+// Requires ValidateCalibration (src/calibration/rig_dataset.h).
 CalibrationSummary SummarizeCalibration(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);

@@ -345,6 +345,87 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
   return true;
 }
 
+namespace {
+
+// The intrinsics of a camchain entry (`where` names it in errors).
+bool ReadCamchainCamera(const YAML::Node& node, const std::string& where,
+                        colmap::Camera* camera, std::string* error) {
+  KalibrCamera kalibr;
+  std::vector<double> resolution;
+  try {
+    if (!node["camera_model"] || !node["distortion_model"]) {
+      *error = where + " needs camera_model and distortion_model";
+      return false;
+    }
+    kalibr.camera_model = node["camera_model"].as<std::string>();
+    kalibr.distortion_model = node["distortion_model"].as<std::string>();
+  } catch (const YAML::Exception& e) {
+    *error = where + ": " + e.what();
+    return false;
+  }
+  const YAML::Node intrinsics = node["intrinsics"];
+  const YAML::Node coeffs = node["distortion_coeffs"];
+  if (!ReadDoubles(intrinsics, intrinsics ? intrinsics.size() : 0,
+                   &kalibr.intrinsics) ||
+      !ReadDoubles(coeffs, coeffs ? coeffs.size() : 0,
+                   &kalibr.distortion_coeffs) ||
+      !ReadDoubles(node["resolution"], 2, &resolution)) {
+    *error = where +
+             " needs intrinsics, distortion_coeffs and resolution as lists "
+             "of numbers";
+    return false;
+  }
+  if (resolution[0] != std::floor(resolution[0]) ||
+      resolution[1] != std::floor(resolution[1]) || resolution[0] < 1 ||
+      resolution[1] < 1 || resolution[0] > 1e6 || resolution[1] > 1e6) {
+    *error = where + ": the resolution must be two positive integers";
+    return false;
+  }
+  kalibr.width = static_cast<int>(resolution[0]);
+  kalibr.height = static_cast<int>(resolution[1]);
+  std::string camera_error;
+  if (!KalibrToColmapCamera(kalibr, camera, &camera_error)) {
+    *error = where + ": " + camera_error;
+    return false;
+  }
+  return true;
+}
+
+// T_cn_cnm1 of a camchain entry: a 4x4 rigid transform, its rotation made
+// exactly orthonormal.
+bool ReadCamchainTransform(const YAML::Node& node, const std::string& where,
+                           Rigid3d* cn_from_cnm1, std::string* error) {
+  std::vector<double> rows[4];
+  const YAML::Node t = node["T_cn_cnm1"];
+  bool valid = t && t.IsSequence() && t.size() == 4;
+  for (int r = 0; valid && r < 4; ++r) {
+    valid = ReadDoubles(t[r], 4, &rows[r]);
+  }
+  if (!valid) {
+    *error = where + " needs T_cn_cnm1 as a 4x4 matrix";
+    return false;
+  }
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  for (int r = 0; r < 3; ++r) {
+    rotation.row(r) << rows[r][0], rows[r][1], rows[r][2];
+    translation(r) = rows[r][3];
+  }
+  const bool last_row_valid =
+      rows[3][0] == 0 && rows[3][1] == 0 && rows[3][2] == 0 && rows[3][3] == 1;
+  if (!last_row_valid ||
+      (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() >
+          1e-6 ||
+      rotation.determinant() < 0) {
+    *error = where + ": T_cn_cnm1 is not a rigid transform";
+    return false;
+  }
+  *cn_from_cnm1 = Rigid3d(NearestRotation(rotation), translation);
+  return true;
+}
+
+}  // namespace
+
 bool ReadCamchainYaml(const std::string& path, RigDescription* rig,
                       std::string* error) {
   *rig = RigDescription();
@@ -369,74 +450,14 @@ bool ReadCamchainYaml(const std::string& path, RigDescription* rig,
       *error = where + " is not a map";
       return false;
     }
-    KalibrCamera kalibr;
-    std::vector<double> resolution;
-    try {
-      if (!node["camera_model"] || !node["distortion_model"]) {
-        *error = where + " needs camera_model and distortion_model";
-        return false;
-      }
-      kalibr.camera_model = node["camera_model"].as<std::string>();
-      kalibr.distortion_model = node["distortion_model"].as<std::string>();
-    } catch (const YAML::Exception& e) {
-      *error = where + ": " + e.what();
-      return false;
-    }
-    const YAML::Node intrinsics = node["intrinsics"];
-    const YAML::Node coeffs = node["distortion_coeffs"];
-    if (!ReadDoubles(intrinsics, intrinsics ? intrinsics.size() : 0,
-                     &kalibr.intrinsics) ||
-        !ReadDoubles(coeffs, coeffs ? coeffs.size() : 0,
-                     &kalibr.distortion_coeffs) ||
-        !ReadDoubles(node["resolution"], 2, &resolution)) {
-      *error = where +
-               " needs intrinsics, distortion_coeffs and resolution as lists "
-               "of numbers";
-      return false;
-    }
-    if (resolution[0] != std::floor(resolution[0]) ||
-        resolution[1] != std::floor(resolution[1]) || resolution[0] < 1 ||
-        resolution[1] < 1 || resolution[0] > 1e6 || resolution[1] > 1e6) {
-      *error = where + ": the resolution must be two positive integers";
-      return false;
-    }
-    kalibr.width = static_cast<int>(resolution[0]);
-    kalibr.height = static_cast<int>(resolution[1]);
     colmap::Camera camera;
-    std::string camera_error;
-    if (!KalibrToColmapCamera(kalibr, &camera, &camera_error)) {
-      *error = where + ": " + camera_error;
-      return false;
-    }
-
+    if (!ReadCamchainCamera(node, where, &camera, error)) return false;
     if (index > 0) {
-      std::vector<double> rows[4];
-      const YAML::Node t = node["T_cn_cnm1"];
-      bool valid = t && t.IsSequence() && t.size() == 4;
-      for (int r = 0; valid && r < 4; ++r) {
-        valid = ReadDoubles(t[r], 4, &rows[r]);
-      }
-      if (!valid) {
-        *error = where + " needs T_cn_cnm1 as a 4x4 matrix";
+      Rigid3d cn_from_cnm1;
+      if (!ReadCamchainTransform(node, where, &cn_from_cnm1, error)) {
         return false;
       }
-      Eigen::Matrix3d rotation;
-      Eigen::Vector3d translation;
-      for (int r = 0; r < 3; ++r) {
-        rotation.row(r) << rows[r][0], rows[r][1], rows[r][2];
-        translation(r) = rows[r][3];
-      }
-      const bool last_row_valid = rows[3][0] == 0 && rows[3][1] == 0 &&
-                                  rows[3][2] == 0 && rows[3][3] == 1;
-      if (!last_row_valid ||
-          (rotation.transpose() * rotation - Eigen::Matrix3d::Identity())
-                  .norm() > 1e-6 ||
-          rotation.determinant() < 0) {
-        *error = where + ": T_cn_cnm1 is not a rigid transform";
-        return false;
-      }
-      cam_from_cam0 =
-          Rigid3d(NearestRotation(rotation), translation) * cam_from_cam0;
+      cam_from_cam0 = cn_from_cnm1 * cam_from_cam0;
     }
     RigDescriptionCamera rig_camera;
     rig_camera.name = key;

@@ -99,6 +99,53 @@ bool StepFeatureRow(sqlite3_stmt* statement, const colmap::image_t image_id,
   return true;
 }
 
+// A regular file that starts with the 16-byte SQLite header: checking it
+// first gives a clear message instead of SQLite's "file is not a database".
+bool CheckSqliteFile(const std::string& path, std::string* problem) {
+  namespace fs = std::filesystem;
+  std::error_code fs_error;
+  if (!fs::exists(path, fs_error)) {
+    *problem = "no such file";
+    return false;
+  }
+  if (!fs::is_regular_file(path, fs_error)) {
+    *problem = "not a regular file";
+    return false;
+  }
+  static const char kSqliteHeader[16] = "SQLite format 3";
+  char header[16] = {};
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    *problem = "cannot be opened for reading";
+    return false;
+  }
+  file.read(header, sizeof(header));
+  if (file.gcount() != sizeof(header) ||
+      std::memcmp(header, kSqliteHeader, sizeof(header)) != 0) {
+    *problem =
+        "not an SQLite file, so not a COLMAP database (create one with "
+        "`colmap feature_extractor --database_path ...`)";
+    return false;
+  }
+  return true;
+}
+
+// COLMAP leaves its databases in WAL mode. A read-only connection to a WAL
+// database creates "-shm"/"-wal" files next to it; `immutable=1` avoids
+// that (no locks, no side files). A non-empty "-wal" file holds committed
+// data not yet copied into the database (COLMAP still running or killed),
+// which only a normal read-only connection reads.
+std::string ReadOnlyUri(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code fs_error;
+  const fs::path wal_path = path + "-wal";
+  const bool has_pending_wal =
+      fs::exists(wal_path, fs_error) && fs::file_size(wal_path, fs_error) > 0;
+  const std::string absolute_path = fs::absolute(path, fs_error).string();
+  return "file:" + EscapeUriPath(absolute_path) +
+         (has_pending_wal ? "?mode=ro" : "?mode=ro&immutable=1");
+}
+
 }  // namespace
 
 DatabaseReader::DatabaseReader() = default;
@@ -123,52 +170,15 @@ void DatabaseReader::Close() {
 }
 
 bool DatabaseReader::Open(const std::string& path, std::string* error) {
-  namespace fs = std::filesystem;
   Close();
   path_ = path;
   const std::string prefix = "database " + path + ": ";
-
-  std::error_code fs_error;
-  if (!fs::exists(path, fs_error)) {
-    *error = prefix + "no such file";
+  std::string problem;
+  if (!CheckSqliteFile(path, &problem)) {
+    *error = prefix + problem;
     return false;
   }
-  if (!fs::is_regular_file(path, fs_error)) {
-    *error = prefix + "not a regular file";
-    return false;
-  }
-  // An SQLite file starts with this 16-byte header; checking it first gives
-  // a clear message instead of SQLite's "file is not a database".
-  static const char kSqliteHeader[16] = "SQLite format 3";
-  char header[16] = {};
-  {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) {
-      *error = prefix + "cannot be opened for reading";
-      return false;
-    }
-    file.read(header, sizeof(header));
-    if (file.gcount() != sizeof(header) ||
-        std::memcmp(header, kSqliteHeader, sizeof(header)) != 0) {
-      *error = prefix +
-               "not an SQLite file, so not a COLMAP database (create one with "
-               "`colmap feature_extractor --database_path ...`)";
-      return false;
-    }
-  }
-
-  // COLMAP leaves its databases in WAL mode. A read-only connection to a WAL
-  // database creates "-shm"/"-wal" files next to it; `immutable=1` avoids
-  // that (no locks, no side files). A non-empty "-wal" file holds committed
-  // data not yet copied into the database (COLMAP still running or killed),
-  // which only a normal read-only connection reads.
-  const fs::path wal_path = path + "-wal";
-  const bool has_pending_wal =
-      fs::exists(wal_path, fs_error) && fs::file_size(wal_path, fs_error) > 0;
-  const std::string absolute_path = fs::absolute(path, fs_error).string();
-  const std::string uri =
-      "file:" + EscapeUriPath(absolute_path) +
-      (has_pending_wal ? "?mode=ro" : "?mode=ro&immutable=1");
+  const std::string uri = ReadOnlyUri(path);
   if (sqlite3_open_v2(
           uri.c_str(), &database_,
           SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_FULLMUTEX,
@@ -178,13 +188,15 @@ bool DatabaseReader::Open(const std::string& path, std::string* error) {
     Close();
     return false;
   }
-
-  if (!CheckSchema(error) || !ReadImages(error)) {
+  if (!CheckSchema(error) || !ReadImages(error) || !PrepareStatements(error)) {
     *error = prefix + *error;
     Close();
     return false;
   }
+  return true;
+}
 
+bool DatabaseReader::PrepareStatements(std::string* error) {
   const struct {
     sqlite3_stmt** statement;
     const char* sql;
@@ -204,8 +216,7 @@ bool DatabaseReader::Open(const std::string& path, std::string* error) {
   for (const auto& [statement, sql] : statements) {
     if (sqlite3_prepare_v2(database_, sql, -1, statement, nullptr) !=
         SQLITE_OK) {
-      *error = prefix + "unexpected schema: " + sqlite3_errmsg(database_);
-      Close();
+      *error = std::string("unexpected schema: ") + sqlite3_errmsg(database_);
       return false;
     }
   }

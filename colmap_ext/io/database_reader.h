@@ -94,6 +94,8 @@ class DatabaseReader {
  private:
   bool CheckSchema(std::string* error);
   bool ReadImages(std::string* error);
+  // Prepares the cached statements of the readers.
+  bool PrepareStatements(std::string* error);
   int CountRows(sqlite3_stmt* statement, colmap::image_t image_id) const;
   // "image <name> (id <id>)" for messages.
   std::string ImageLabel(colmap::image_t image_id) const;

@@ -134,61 +134,64 @@ bool ModelCameras(const RigDataset& dataset, const RigCalibration& calibration,
 
 }  // namespace
 
-bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
-                   const RigCalibration& calibration, RigModel* rig_model,
-                   std::string* error) {
-  if (!CheckCalibrationMatchesDataset(dataset, calibration, error)) {
-    return false;
-  }
-  const size_t num_cameras = dataset.cameras.size();
-  std::vector<colmap::Camera> cameras;
-  if (!ModelCameras(dataset, calibration, &cameras, error)) return false;
+namespace {
 
-  const colmap::camera_t max_camera_id = MaxCameraId(map);
-  const colmap::image_t max_image_id = MaxImageId(map);
-  std::unordered_set<std::string> map_names;
-  for (const auto& [image_id, image] : map.Images()) {
-    map_names.insert(image.Name());
-  }
-  // Keep clear of kInvalidCameraId/kInvalidImageId (the uint32 maximum) and
-  // leave room for the rig frame ids that follow the image ids.
+// Keep clear of kInvalidCameraId/kInvalidImageId (the uint32 maximum) and
+// leave room for the rig frame ids that follow the image ids.
+bool CheckRoomForRigIds(const RigDataset& dataset,
+                        colmap::camera_t max_camera_id,
+                        colmap::image_t max_image_id, std::string* error) {
   constexpr uint64_t kMaxId = std::numeric_limits<uint32_t>::max() / 2;
-  if (max_camera_id + static_cast<uint64_t>(num_cameras) >= kMaxId ||
+  if (max_camera_id + static_cast<uint64_t>(dataset.cameras.size()) >= kMaxId ||
       max_image_id + 2 * static_cast<uint64_t>(dataset.images.size()) >=
           kMaxId) {
     *error = "the map's camera or image ids are too large to add the rig";
     return false;
   }
+  return true;
+}
 
-  rig_model->model = map;
-  colmap::Reconstruction& model = rig_model->model;
-  if (!MoveRefinedPoints(calibration, &model, error)) {
-    return false;
+// Adds the cameras after the map's (ids max_camera_id + 1, ...) and sets the
+// rig: the rig frame is the reference camera's frame, cam_from_ref =
+// cam_from_rig * (ref_from_rig)^-1 (unset for an uncalibrated camera).
+void AddRigCameras(const RigDataset& dataset, const RigCalibration& calibration,
+                   std::vector<colmap::Camera> cameras,
+                   colmap::camera_t max_camera_id,
+                   colmap::Reconstruction* model, ModelRig* rig) {
+  const Rigid3d& ref_from_rig =
+      calibration.cam_from_rig[dataset.reference_camera];
+  *rig = ModelRig();
+  rig->reference_camera = dataset.reference_camera;
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    cameras[c].SetCameraId(max_camera_id + 1 +
+                           static_cast<colmap::camera_t>(c));
+    model->AddCamera(cameras[c]);
+    rig->camera_ids.push_back(cameras[c].CameraId());
+    if (!calibration.camera_calibrated[c]) {
+      rig->cam_from_rig.emplace_back();
+    } else if (static_cast<int>(c) == dataset.reference_camera) {
+      rig->cam_from_rig.emplace_back(Rigid3d());
+    } else {
+      rig->cam_from_rig.emplace_back(calibration.cam_from_rig[c] *
+                                     ref_from_rig.Inverse());
+    }
   }
+}
 
-  // The rig frame is the reference camera's frame: cam_from_ref =
-  // cam_from_rig * (ref_from_rig)^-1 and ref_from_world = ref_from_rig *
-  // rig_from_world, which leaves every cam_from_world unchanged.
+// Adds every used image of a calibrated camera in a posed frameset (ids
+// max_image_id + 1 + dataset index) and its frame: ref_from_world =
+// ref_from_rig * rig_from_world, which leaves every cam_from_world unchanged.
+bool AddRigFrames(const colmap::Reconstruction& map, const RigDataset& dataset,
+                  const RigCalibration& calibration,
+                  colmap::image_t max_image_id, RigModel* rig_model,
+                  std::string* error) {
+  std::unordered_set<std::string> map_names;
+  for (const auto& [image_id, image] : map.Images()) {
+    map_names.insert(image.Name());
+  }
   const Rigid3d& ref_from_rig =
       calibration.cam_from_rig[dataset.reference_camera];
   ModelRig& rig = rig_model->rig;
-  rig = ModelRig();
-  rig.reference_camera = dataset.reference_camera;
-  for (size_t c = 0; c < num_cameras; ++c) {
-    cameras[c].SetCameraId(max_camera_id + 1 +
-                           static_cast<colmap::camera_t>(c));
-    model.AddCamera(cameras[c]);
-    rig.camera_ids.push_back(cameras[c].CameraId());
-    if (!calibration.camera_calibrated[c]) {
-      rig.cam_from_rig.emplace_back();
-    } else if (static_cast<int>(c) == dataset.reference_camera) {
-      rig.cam_from_rig.emplace_back(Rigid3d());
-    } else {
-      rig.cam_from_rig.emplace_back(calibration.cam_from_rig[c] *
-                                    ref_from_rig.Inverse());
-    }
-  }
-
   std::vector<int> frame_of_frameset(dataset.frameset_names.size(), -1);
   rig_model->image_ids.assign(dataset.images.size(), colmap::kInvalidImageId);
   for (size_t i = 0; i < dataset.images.size(); ++i) {
@@ -214,11 +217,36 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
     const colmap::image_t image_id =
         max_image_id + 1 + static_cast<colmap::image_t>(i);
     AddRigImage(rig_image, calibration.images[i].inlier_mask, image_id,
-                rig.camera_ids[c], cam_from_world, &model);
+                rig.camera_ids[c], cam_from_world, &rig_model->model);
     rig_model->image_ids[i] = image_id;
     frame.image_ids.push_back(image_id);
   }
   return true;
+}
+
+}  // namespace
+
+bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
+                   const RigCalibration& calibration, RigModel* rig_model,
+                   std::string* error) {
+  if (!ValidateCalibration(dataset, calibration, error)) {
+    return false;
+  }
+  std::vector<colmap::Camera> cameras;
+  if (!ModelCameras(dataset, calibration, &cameras, error)) return false;
+  const colmap::camera_t max_camera_id = MaxCameraId(map);
+  const colmap::image_t max_image_id = MaxImageId(map);
+  if (!CheckRoomForRigIds(dataset, max_camera_id, max_image_id, error)) {
+    return false;
+  }
+  rig_model->model = map;
+  if (!MoveRefinedPoints(calibration, &rig_model->model, error)) {
+    return false;
+  }
+  AddRigCameras(dataset, calibration, std::move(cameras), max_camera_id,
+                &rig_model->model, &rig_model->rig);
+  return AddRigFrames(map, dataset, calibration, max_image_id, rig_model,
+                      error);
 }
 
 namespace {
@@ -272,6 +300,100 @@ std::vector<std::string> RigConfigNotes(const RigModel& rig_model,
 
 }  // namespace
 
+namespace {
+
+// Everything written into the output folder, built before the folder is
+// touched (what can fail for reasons other than the file system fails here).
+struct RigOutputContents {
+  bool binary = true;
+  RigModel rig_model;
+  ColmapRigsAndFrames rigs_frames;
+  RigDescription rig;
+  bool reference_calibrated = false;
+  std::vector<std::string> notes;
+};
+
+bool BuildRigOutputContents(const colmap::Reconstruction& map,
+                            const RigDataset& dataset,
+                            const RigCalibration& calibration,
+                            const std::vector<std::string>& camera_prefixes,
+                            const RigOutputOptions& options,
+                            RigOutputContents* contents, std::string* error) {
+  std::string output_type = options.output_type;
+  std::transform(output_type.begin(), output_type.end(), output_type.begin(),
+                 [](unsigned char c) { return std::toupper(c); });
+  if (output_type != "BIN" && output_type != "TXT") {
+    *error = "output_type must be BIN or TXT, not " + options.output_type;
+    return false;
+  }
+  contents->binary = output_type == "BIN";
+  if (!camera_prefixes.empty() &&
+      camera_prefixes.size() != dataset.cameras.size()) {
+    *error = "one camera prefix per camera is needed";
+    return false;
+  }
+  if (!BuildRigModel(map, dataset, calibration, &contents->rig_model, error) ||
+      !BuildRigsAndFrames(contents->rig_model.model, contents->rig_model.rig,
+                          &contents->rigs_frames, error)) {
+    return false;
+  }
+  RigDescription& rig = contents->rig;
+  rig = DescribeCalibratedRig(dataset, calibration, camera_prefixes);
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    if (rig.cameras[c].camera) {
+      rig.cameras[c].camera->SetCameraId(contents->rig_model.rig.camera_ids[c]);
+    }
+  }
+  contents->reference_calibrated =
+      rig.cameras[rig.reference_camera].camera.has_value();
+  contents->notes =
+      RigConfigNotes(contents->rig_model, rig, contents->reference_calibrated);
+  return true;
+}
+
+// Writes the files into `folder`; notes of the camchain writer are added to
+// contents->notes, which the summary then lists.
+bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
+                         const CalibrationSummary& summary,
+                         RigOutputContents* contents, std::string* error) {
+  const bool binary = contents->binary;
+  if (binary) {
+    contents->rig_model.model.WriteBinary(folder);
+  } else {
+    contents->rig_model.model.WriteText(folder);
+  }
+  if (!ModelFilesExist(folder, binary ? ".bin" : ".txt")) {
+    *error = "cannot write the COLMAP model into " + folder;
+    return false;
+  }
+  const RigDescription& rig = contents->rig;
+  if (!WriteRigsAndFrames(folder, contents->rigs_frames, binary, error) ||
+      !WriteRigConfigJson(folder + "/" + kRigConfigFile, rig, error)) {
+    return false;
+  }
+  if (contents->reference_calibrated &&
+      !WriteRigBundleAdjusterConfig(folder + "/" + kRigBundleAdjusterConfigFile,
+                                    rig, error)) {
+    return false;
+  }
+  std::string camchain_error;
+  if (!WriteCamchainYaml(folder + "/" + kCamchainFile, rig, &contents->notes,
+                         &camchain_error)) {
+    contents->notes.push_back(std::string(kCamchainFile) +
+                              " is not written: " + camchain_error);
+  }
+  CalibrationSummary final_summary = summary;
+  final_summary.diagnostics.insert(final_summary.diagnostics.end(),
+                                   contents->notes.begin(),
+                                   contents->notes.end());
+  return WriteCalibrationSummaryJson(folder + "/" + kSummaryFile, final_summary,
+                                     error) &&
+         WriteCorrespondenceFile(folder + "/" + kCorrespondencesFile,
+                                 DatasetCorrespondences(dataset), error);
+}
+
+}  // namespace
+
 bool WriteRigOutput(const std::string& output_path,
                     const colmap::Reconstruction& map,
                     const RigDataset& dataset,
@@ -280,86 +402,25 @@ bool WriteRigOutput(const std::string& output_path,
                     const CalibrationSummary& summary,
                     const RigOutputOptions& options,
                     std::vector<std::string>* notes, std::string* error) {
-  std::string output_type = options.output_type;
-  std::transform(output_type.begin(), output_type.end(), output_type.begin(),
-                 [](unsigned char c) { return std::toupper(c); });
-  if (output_type != "BIN" && output_type != "TXT") {
-    *error = "output_type must be BIN or TXT, not " + options.output_type;
+  RigOutputContents contents;
+  if (!BuildRigOutputContents(map, dataset, calibration, camera_prefixes,
+                              options, &contents, error)) {
     return false;
   }
-  const bool binary = output_type == "BIN";
-  if (!camera_prefixes.empty() &&
-      camera_prefixes.size() != dataset.cameras.size()) {
-    *error = "one camera prefix per camera is needed";
-    return false;
-  }
-
-  // Everything that can fail for reasons other than the file system is done
-  // before the output folder is touched.
-  RigModel rig_model;
-  if (!BuildRigModel(map, dataset, calibration, &rig_model, error)) {
-    return false;
-  }
-  ColmapRigsAndFrames rigs_frames;
-  if (!BuildRigsAndFrames(rig_model.model, rig_model.rig, &rigs_frames,
-                          error)) {
-    return false;
-  }
-  RigDescription rig =
-      DescribeCalibratedRig(dataset, calibration, camera_prefixes);
-  for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    if (rig.cameras[c].camera) {
-      rig.cameras[c].camera->SetCameraId(rig_model.rig.camera_ids[c]);
-    }
-  }
-
-  const bool reference_calibrated =
-      rig.cameras[rig.reference_camera].camera.has_value();
-  std::vector<std::string> new_notes =
-      RigConfigNotes(rig_model, rig, reference_calibrated);
-
-  auto write_contents = [&](const std::string& folder, std::string* error) {
-    if (binary) {
-      rig_model.model.WriteBinary(folder);
-    } else {
-      rig_model.model.WriteText(folder);
-    }
-    if (!ModelFilesExist(folder, binary ? ".bin" : ".txt")) {
-      *error = "cannot write the COLMAP model into " + folder;
-      return false;
-    }
-    if (!WriteRigsAndFrames(folder, rigs_frames, binary, error) ||
-        !WriteRigConfigJson(folder + "/" + kRigConfigFile, rig, error)) {
-      return false;
-    }
-    if (reference_calibrated &&
-        !WriteRigBundleAdjusterConfig(
-            folder + "/" + kRigBundleAdjusterConfigFile, rig, error)) {
-      return false;
-    }
-    std::string camchain_error;
-    if (!WriteCamchainYaml(folder + "/" + kCamchainFile, rig, &new_notes,
-                           &camchain_error)) {
-      new_notes.push_back(std::string(kCamchainFile) +
-                          " is not written: " + camchain_error);
-    }
-    CalibrationSummary final_summary = summary;
-    final_summary.diagnostics.insert(final_summary.diagnostics.end(),
-                                     new_notes.begin(), new_notes.end());
-    return WriteCalibrationSummaryJson(folder + "/" + kSummaryFile,
-                                       final_summary, error) &&
-           WriteCorrespondenceFile(folder + "/" + kCorrespondencesFile,
-                                   DatasetCorrespondences(dataset), error);
-  };
   OutputFolderOptions folder_options;
   folder_options.overwrite = options.overwrite;
   folder_options.input_paths = options.input_paths;
-  if (!WriteFolderAtomically(output_path, folder_options, write_contents,
-                             error)) {
+  if (!WriteFolderAtomically(
+          output_path, folder_options,
+          [&](const std::string& folder, std::string* write_error) {
+            return WriteRigOutputFiles(folder, dataset, summary, &contents,
+                                       write_error);
+          },
+          error)) {
     return false;
   }
   if (notes != nullptr) {
-    notes->insert(notes->end(), new_notes.begin(), new_notes.end());
+    notes->insert(notes->end(), contents.notes.begin(), contents.notes.end());
   }
   return true;
 }

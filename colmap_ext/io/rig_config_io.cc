@@ -67,32 +67,11 @@ bool ReadNumbers(const Json& value, size_t size, std::vector<double>* numbers) {
   return true;
 }
 
-bool ReadRigCamera(const Json& node, const std::string& where,
-                   RigDescriptionCamera* camera, bool* ref_sensor,
-                   std::string* error) {
-  if (!node.is_object()) {
-    *error = where + " is not an object";
-    return false;
-  }
-  if (!node.contains("image_prefix") || !node["image_prefix"].is_string() ||
-      node["image_prefix"].get<std::string>().empty()) {
-    *error = where + " has no image_prefix";
-    return false;
-  }
-  camera->image_prefix = node["image_prefix"].get<std::string>();
-  camera->name = camera->image_prefix;
-  if (camera->name.size() > 1 && camera->name.back() == '/') {
-    camera->name.pop_back();
-  }
-  *ref_sensor = false;
-  if (node.contains("ref_sensor")) {
-    if (!node["ref_sensor"].is_boolean()) {
-      *error = where + ": ref_sensor must be true or false";
-      return false;
-    }
-    *ref_sensor = node["ref_sensor"].get<bool>();
-  }
-
+// cam_from_rig_rotation/_translation (both or neither; none for the reference
+// sensor, whose pose is the identity).
+bool ReadRigCameraPose(const Json& node, const std::string& where,
+                       bool ref_sensor, RigDescriptionCamera* camera,
+                       std::string* error) {
   const bool has_rotation = node.contains("cam_from_rig_rotation");
   const bool has_translation = node.contains("cam_from_rig_translation");
   if (has_rotation != has_translation) {
@@ -102,7 +81,7 @@ bool ReadRigCamera(const Json& node, const std::string& where,
     return false;
   }
   if (has_rotation) {
-    if (*ref_sensor) {
+    if (ref_sensor) {
       *error = where + ": the reference sensor must not have a pose";
       return false;
     }
@@ -121,10 +100,15 @@ bool ReadRigCamera(const Json& node, const std::string& where,
       return false;
     }
     camera->cam_from_rig = Rigid3d(rotation, Eigen::Vector3d(t[0], t[1], t[2]));
-  } else if (*ref_sensor) {
+  } else if (ref_sensor) {
     camera->cam_from_rig = Rigid3d();
   }
+  return true;
+}
 
+// camera_model_name and camera_params (both or neither).
+bool ReadRigCameraIntrinsics(const Json& node, const std::string& where,
+                             RigDescriptionCamera* camera, std::string* error) {
   const bool has_model = node.contains("camera_model_name");
   const bool has_params = node.contains("camera_params");
   if (has_model != has_params) {
@@ -159,6 +143,36 @@ bool ReadRigCamera(const Json& node, const std::string& where,
     camera->camera = intrinsics;
   }
   return true;
+}
+
+bool ReadRigCamera(const Json& node, const std::string& where,
+                   RigDescriptionCamera* camera, bool* ref_sensor,
+                   std::string* error) {
+  if (!node.is_object()) {
+    *error = where + " is not an object";
+    return false;
+  }
+  if (!node.contains("image_prefix") || !node["image_prefix"].is_string() ||
+      node["image_prefix"].get<std::string>().empty()) {
+    *error = where + " has no image_prefix";
+    return false;
+  }
+  camera->image_prefix = node["image_prefix"].get<std::string>();
+  camera->name = camera->image_prefix;
+  if (camera->name.size() > 1 && camera->name.back() == '/') {
+    camera->name.pop_back();
+  }
+  *ref_sensor = false;
+  if (node.contains("ref_sensor")) {
+    if (!node["ref_sensor"].is_boolean()) {
+      *error = where + ": ref_sensor must be true or false";
+      return false;
+    }
+    *ref_sensor = node["ref_sensor"].get<bool>();
+  }
+
+  return ReadRigCameraPose(node, where, *ref_sensor, camera, error) &&
+         ReadRigCameraIntrinsics(node, where, camera, error);
 }
 
 }  // namespace

@@ -32,21 +32,13 @@ struct RigDescription {
   int reference_camera = 0;  // its cam_from_rig is the identity
 };
 
-// Fails unless `dataset` is valid (ValidateDataset) and `calibration` has one
-// entry per camera, frameset and image of it, every inlier mask is empty or
-// has one entry per correspondence, and all poses are finite. The functions
-// below and the writers assume this.
-bool CheckCalibrationMatchesDataset(const RigDataset& dataset,
-                                    const RigCalibration& calibration,
-                                    std::string* error);
-
 // The calibrated rig of `calibration`, re-expressed so that the rig frame is
 // exactly the reference camera's frame: cam_from_ref = cam_from_rig *
 // (ref_from_rig)^-1 (the identity for the reference camera whatever rounding
 // the solver left). Cameras with camera_calibrated false have neither
 // intrinsics nor cam_from_rig. `image_prefixes` (one per camera) may be empty:
 // the prefix is then the camera's name followed by '/'. Requires
-// CheckCalibrationMatchesDataset.
+// ValidateCalibration (src/calibration/rig_dataset.h).
 RigDescription DescribeCalibratedRig(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);

@@ -149,6 +149,162 @@ bool CheckUniqueAndNonEmpty(const std::vector<std::string>& names,
   return true;
 }
 
+// The camera prefixes, given or (default) the first-level folders of the
+// image names, in natural order.
+bool CameraPrefixes(const std::vector<std::string>& image_names,
+                    const RigLayoutOptions& options,
+                    std::vector<std::string>* camera_prefixes,
+                    std::string* error) {
+  std::vector<std::string>& prefixes = *camera_prefixes;
+  prefixes = options.camera_prefixes;
+  if (prefixes.empty()) {
+    std::unordered_set<std::string> folders;
+    for (const std::string& name : image_names) {
+      const size_t slash = name.find('/');
+      if (slash != std::string::npos && slash > 0) {
+        folders.insert(name.substr(0, slash + 1));
+      }
+    }
+    if (folders.empty()) {
+      *error = "no camera folders: none of the " +
+               std::to_string(image_names.size()) +
+               " image names is in a folder; put each camera's images in its "
+               "own folder (cam0/..., cam1/...) or give the camera prefixes";
+      return false;
+    }
+    prefixes.assign(folders.begin(), folders.end());
+  } else if (!CheckUniqueAndNonEmpty(prefixes, "a camera prefix",
+                                     "the camera prefix", "is given twice",
+                                     error)) {
+    return false;
+  }
+  std::sort(prefixes.begin(), prefixes.end(), NaturalLess);
+  return true;
+}
+
+// Each image's camera (the longest matching prefix; images of none are
+// ignored) and its key, the name after the prefix; fails for a camera
+// without images and for fewer than two cameras.
+bool AssignCameras(const std::vector<std::string>& image_names,
+                   const std::vector<std::string>& prefixes, RigLayout* layout,
+                   std::vector<std::string>* image_keys, std::string* error) {
+  const int num_cameras = static_cast<int>(prefixes.size());
+  std::vector<std::string>& keys = *image_keys;
+  layout->images.resize(image_names.size());
+  std::vector<int> camera_num_images(num_cameras, 0);
+  keys.assign(image_names.size(), std::string());
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    const std::string& name = image_names[i];
+    int best = -1;
+    for (int c = 0; c < num_cameras; ++c) {
+      if (name.size() > prefixes[c].size() &&
+          name.compare(0, prefixes[c].size(), prefixes[c]) == 0 &&
+          (best < 0 || prefixes[c].size() > prefixes[best].size())) {
+        best = c;
+      }
+    }
+    if (best < 0) {
+      layout->ignored_images.push_back(static_cast<int>(i));
+      continue;
+    }
+    layout->images[i].camera_index = best;
+    keys[i] = name.substr(prefixes[best].size());
+    ++camera_num_images[best];
+  }
+  for (int c = 0; c < num_cameras; ++c) {
+    if (camera_num_images[c] == 0) {
+      *error = "the camera prefix " + prefixes[c] + " matches no image";
+      return false;
+    }
+  }
+  if (num_cameras < 2) {
+    *error = "a rig needs at least two cameras: found only " + prefixes[0] +
+             " (" + std::to_string(camera_num_images[0]) +
+             " images); put each camera's images in its own folder (cam0/, "
+             "cam1/, ...) or give the camera prefixes";
+    return false;
+  }
+  layout->camera_prefixes = prefixes;
+  for (const std::string& prefix : prefixes) {
+    layout->camera_names.push_back(
+        prefix.back() == '/' ? prefix.substr(0, prefix.size() - 1) : prefix);
+  }
+  return true;
+}
+
+// The framesets, each a list of input indices: the images with the same key,
+// or (timestamp_tolerance > 0) the clusters of close timestamps per folder.
+bool GroupFramesets(const std::vector<std::string>& image_names,
+                    const std::vector<std::string>& keys,
+                    const RigLayoutOptions& options, const RigLayout& layout,
+                    std::vector<std::vector<int>>* framesets,
+                    std::string* error) {
+  if (options.timestamp_tolerance > 0) {
+    std::vector<TimedKey> timed_keys(image_names.size());
+    std::map<std::string, std::vector<int>> folder_images;
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index < 0) continue;
+      if (!ParseTimedKey(keys[i], &timed_keys[i])) {
+        *error = "timestamp_tolerance is set but the image " + image_names[i] +
+                 " has no numeric name (expected e.g. " +
+                 layout.camera_prefixes[layout.images[i].camera_index] +
+                 "1403715273262142976.png)";
+        return false;
+      }
+      folder_images[timed_keys[i].folder].push_back(static_cast<int>(i));
+    }
+    std::vector<std::string> folders;
+    for (const auto& entry : folder_images) folders.push_back(entry.first);
+    std::sort(folders.begin(), folders.end(), NaturalLess);
+    for (const std::string& folder : folders) {
+      for (std::vector<int>& cluster :
+           ClusterTimestamps(folder_images[folder], timed_keys, layout.images,
+                             options.timestamp_tolerance)) {
+        framesets->push_back(std::move(cluster));
+      }
+    }
+  } else {
+    std::map<std::string, std::vector<int>> key_images;
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index >= 0) {
+        key_images[keys[i]].push_back(static_cast<int>(i));
+      }
+    }
+    std::vector<std::string> sorted_keys;
+    for (const auto& entry : key_images) sorted_keys.push_back(entry.first);
+    std::sort(sorted_keys.begin(), sorted_keys.end(), NaturalLess);
+    for (const std::string& key : sorted_keys) {
+      framesets->push_back(key_images[key]);
+    }
+  }
+  return true;
+}
+
+// Names the framesets after their first image's key (unique), sets each
+// image's frameset and lists the images alone in their frameset.
+void NameFramesets(const std::vector<std::string>& keys,
+                   const std::vector<std::vector<int>>& framesets,
+                   RigLayout* layout) {
+  std::unordered_set<std::string> frameset_names;
+  for (size_t f = 0; f < framesets.size(); ++f) {
+    // Keys are unique in the exact mode; with timestamps two framesets can
+    // start with equal keys of different cameras, and a suffix keeps the
+    // names unique.
+    std::string name = keys[framesets[f].front()];
+    for (int copy = 2; !frameset_names.insert(name).second; ++copy) {
+      name = keys[framesets[f].front()] + "~" + std::to_string(copy);
+    }
+    layout->frameset_names.push_back(name);
+    for (const int image : framesets[f]) {
+      layout->images[image].frameset_index = static_cast<int>(f);
+    }
+    if (framesets[f].size() == 1) {
+      layout->unmatched_images.push_back(framesets[f].front());
+    }
+  }
+  std::sort(layout->unmatched_images.begin(), layout->unmatched_images.end());
+}
+
 }  // namespace
 
 bool NaturalLess(const std::string& a, const std::string& b) {
@@ -206,133 +362,15 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
                               "appears twice", error)) {
     return false;
   }
-
-  // Cameras.
-  std::vector<std::string> prefixes = options.camera_prefixes;
-  if (prefixes.empty()) {
-    std::unordered_set<std::string> folders;
-    for (const std::string& name : image_names) {
-      const size_t slash = name.find('/');
-      if (slash != std::string::npos && slash > 0) {
-        folders.insert(name.substr(0, slash + 1));
-      }
-    }
-    if (folders.empty()) {
-      *error = "no camera folders: none of the " +
-               std::to_string(image_names.size()) +
-               " image names is in a folder; put each camera's images in its "
-               "own folder (cam0/..., cam1/...) or give the camera prefixes";
-      return false;
-    }
-    prefixes.assign(folders.begin(), folders.end());
-  } else if (!CheckUniqueAndNonEmpty(prefixes, "a camera prefix",
-                                     "the camera prefix", "is given twice",
-                                     error)) {
-    return false;
-  }
-  std::sort(prefixes.begin(), prefixes.end(), NaturalLess);
-  const int num_cameras = static_cast<int>(prefixes.size());
-
-  layout->images.resize(image_names.size());
-  std::vector<int> camera_num_images(num_cameras, 0);
-  std::vector<std::string> keys(image_names.size());
-  for (size_t i = 0; i < image_names.size(); ++i) {
-    const std::string& name = image_names[i];
-    int best = -1;
-    for (int c = 0; c < num_cameras; ++c) {
-      if (name.size() > prefixes[c].size() &&
-          name.compare(0, prefixes[c].size(), prefixes[c]) == 0 &&
-          (best < 0 || prefixes[c].size() > prefixes[best].size())) {
-        best = c;
-      }
-    }
-    if (best < 0) {
-      layout->ignored_images.push_back(static_cast<int>(i));
-      continue;
-    }
-    layout->images[i].camera_index = best;
-    keys[i] = name.substr(prefixes[best].size());
-    ++camera_num_images[best];
-  }
-  for (int c = 0; c < num_cameras; ++c) {
-    if (camera_num_images[c] == 0) {
-      *error = "the camera prefix " + prefixes[c] + " matches no image";
-      return false;
-    }
-  }
-  if (num_cameras < 2) {
-    *error = "a rig needs at least two cameras: found only " + prefixes[0] +
-             " (" + std::to_string(camera_num_images[0]) +
-             " images); put each camera's images in its own folder (cam0/, "
-             "cam1/, ...) or give the camera prefixes";
-    return false;
-  }
-  layout->camera_prefixes = prefixes;
-  for (const std::string& prefix : prefixes) {
-    layout->camera_names.push_back(
-        prefix.back() == '/' ? prefix.substr(0, prefix.size() - 1) : prefix);
-  }
-
-  // Framesets, each a list of input indices.
+  std::vector<std::string> prefixes;
+  std::vector<std::string> keys;
   std::vector<std::vector<int>> framesets;
-  if (options.timestamp_tolerance > 0) {
-    std::vector<TimedKey> timed_keys(image_names.size());
-    std::map<std::string, std::vector<int>> folder_images;
-    for (size_t i = 0; i < image_names.size(); ++i) {
-      if (layout->images[i].camera_index < 0) continue;
-      if (!ParseTimedKey(keys[i], &timed_keys[i])) {
-        *error = "timestamp_tolerance is set but the image " + image_names[i] +
-                 " has no numeric name (expected e.g. " +
-                 layout->camera_prefixes[layout->images[i].camera_index] +
-                 "1403715273262142976.png)";
-        return false;
-      }
-      folder_images[timed_keys[i].folder].push_back(static_cast<int>(i));
-    }
-    std::vector<std::string> folders;
-    for (const auto& entry : folder_images) folders.push_back(entry.first);
-    std::sort(folders.begin(), folders.end(), NaturalLess);
-    for (const std::string& folder : folders) {
-      for (std::vector<int>& cluster :
-           ClusterTimestamps(folder_images[folder], timed_keys, layout->images,
-                             options.timestamp_tolerance)) {
-        framesets.push_back(std::move(cluster));
-      }
-    }
-  } else {
-    std::map<std::string, std::vector<int>> key_images;
-    for (size_t i = 0; i < image_names.size(); ++i) {
-      if (layout->images[i].camera_index >= 0) {
-        key_images[keys[i]].push_back(static_cast<int>(i));
-      }
-    }
-    std::vector<std::string> sorted_keys;
-    for (const auto& entry : key_images) sorted_keys.push_back(entry.first);
-    std::sort(sorted_keys.begin(), sorted_keys.end(), NaturalLess);
-    for (const std::string& key : sorted_keys) {
-      framesets.push_back(key_images[key]);
-    }
+  if (!CameraPrefixes(image_names, options, &prefixes, error) ||
+      !AssignCameras(image_names, prefixes, layout, &keys, error) ||
+      !GroupFramesets(image_names, keys, options, *layout, &framesets, error)) {
+    return false;
   }
-
-  std::unordered_set<std::string> frameset_names;
-  for (size_t f = 0; f < framesets.size(); ++f) {
-    // Keys are unique in the exact mode; with timestamps two framesets can
-    // start with equal keys of different cameras, and a suffix keeps the
-    // names unique.
-    std::string name = keys[framesets[f].front()];
-    for (int copy = 2; !frameset_names.insert(name).second; ++copy) {
-      name = keys[framesets[f].front()] + "~" + std::to_string(copy);
-    }
-    layout->frameset_names.push_back(name);
-    for (const int image : framesets[f]) {
-      layout->images[image].frameset_index = static_cast<int>(f);
-    }
-    if (framesets[f].size() == 1) {
-      layout->unmatched_images.push_back(framesets[f].front());
-    }
-  }
-  std::sort(layout->unmatched_images.begin(), layout->unmatched_images.end());
-
+  NameFramesets(keys, framesets, layout);
   if (!CheckCamerasConnected(*layout, error)) {
     *layout = RigLayout();
     return false;

@@ -12,31 +12,24 @@
 
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/map_reader.h"
+#include "colmap_ext/io/name_table.h"
 #include "colmap_ext/io/number_text.h"
 
 namespace rig_calibrator {
 namespace {
 
+const NameTable<int>& SensorTypeNames() {
+  static const NameTable<int> names = {{kSensorCamera, "CAMERA"},
+                                       {kSensorImu, "IMU"}};
+  return names;
+}
+
 std::string SensorTypeName(int type) {
-  switch (type) {
-    case kSensorCamera:
-      return "CAMERA";
-    case kSensorImu:
-      return "IMU";
-    default:
-      return "INVALID";
-  }
+  return NameOfValue(SensorTypeNames(), type, "INVALID");
 }
 
 bool SensorTypeFromName(const std::string& name, int* type) {
-  if (name == "CAMERA") {
-    *type = kSensorCamera;
-  } else if (name == "IMU") {
-    *type = kSensorImu;
-  } else {
-    return false;
-  }
-  return true;
+  return ValueFromName(SensorTypeNames(), name, type);
 }
 
 bool SameSensor(const ColmapSensorId& a, const ColmapSensorId& b) {
@@ -307,42 +300,11 @@ bool ReadBinary(const std::string& folder, ColmapRigsAndFrames* rigs_frames,
   return true;
 }
 
-}  // namespace
-
-bool BuildRigsAndFrames(const colmap::Reconstruction& model,
-                        const ModelRig& rig, ColmapRigsAndFrames* rigs_frames,
-                        std::string* error) {
-  *rigs_frames = ColmapRigsAndFrames();
-  const int num_rig_cameras = static_cast<int>(rig.camera_ids.size());
-  if (num_rig_cameras == 0 || rig.reference_camera < 0 ||
-      rig.reference_camera >= num_rig_cameras ||
-      static_cast<int>(rig.cam_from_rig.size()) != num_rig_cameras) {
-    *error =
-        "the rig has no cameras, or its reference camera or poses do "
-        "not match its cameras";
-    return false;
-  }
-  std::unordered_map<colmap::camera_t, int> rig_camera_index;
-  for (int c = 0; c < num_rig_cameras; ++c) {
-    if (!model.ExistsCamera(rig.camera_ids[c]) ||
-        !rig_camera_index.emplace(rig.camera_ids[c], c).second) {
-      *error = "the rig camera id " + std::to_string(rig.camera_ids[c]) +
-               " is not in the model or appears twice";
-      return false;
-    }
-  }
-
-  const colmap::camera_t max_camera_id = MaxCameraId(model);
-  const colmap::image_t max_image_id = MaxImageId(model);
-  if (static_cast<uint64_t>(max_camera_id) + 1 >=
-          std::numeric_limits<uint32_t>::max() ||
-      static_cast<uint64_t>(max_image_id) + rig.frames.size() >=
-          std::numeric_limits<uint32_t>::max()) {
-    *error = "the model's ids leave no room for the rig's rig and frame ids";
-    return false;
-  }
-
-  // Trivial rigs, sorted by id as COLMAP writes them.
+// The rigs: a trivial rig per camera outside the calibrated rig, sorted by id
+// as COLMAP writes them, then the calibrated rig.
+void AddRigs(const colmap::Reconstruction& model, const ModelRig& rig,
+             const std::unordered_map<colmap::camera_t, int>& rig_camera_index,
+             uint32_t calibrated_rig_id, ColmapRigsAndFrames* rigs_frames) {
   std::vector<colmap::camera_t> camera_ids;
   for (const auto& [camera_id, camera] : model.Cameras()) {
     if (rig_camera_index.count(camera_id) == 0) camera_ids.push_back(camera_id);
@@ -355,18 +317,62 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
     rigs_frames->rigs.push_back(trivial);
   }
   ColmapRig calibrated;
-  calibrated.rig_id = max_camera_id + 1;
+  calibrated.rig_id = calibrated_rig_id;
   calibrated.ref_sensor = {kSensorCamera, rig.camera_ids[rig.reference_camera]};
-  for (int c = 0; c < num_rig_cameras; ++c) {
+  for (int c = 0; c < static_cast<int>(rig.camera_ids.size()); ++c) {
     if (c == rig.reference_camera) continue;
     calibrated.sensors.push_back(
         {{kSensorCamera, rig.camera_ids[c]}, rig.cam_from_rig[c]});
   }
   rigs_frames->rigs.push_back(calibrated);
+}
 
-  // Rig frames first, to know which images they hold.
-  std::unordered_set<colmap::image_t> in_rig_frame;
-  std::vector<ColmapFrame> rig_frames;
+// An image of a rig frame must be a registered image of a calibrated rig
+// camera, in no other rig frame, with the stored pose cam_from_rig *
+// rig_from_world.
+bool CheckRigFrameImage(
+    const colmap::Reconstruction& model, const ModelRig& rig,
+    const std::unordered_map<colmap::camera_t, int>& rig_camera_index,
+    const Rigid3d& rig_from_world, colmap::image_t image_id,
+    std::unordered_set<colmap::image_t>* in_rig_frame, std::string* error) {
+  if (!model.ExistsImage(image_id) || !model.IsImageRegistered(image_id)) {
+    *error = "the rig frame image " + std::to_string(image_id) +
+             " is not a registered image of the model";
+    return false;
+  }
+  const colmap::Image& image = model.Image(image_id);
+  const auto camera = rig_camera_index.find(image.CameraId());
+  if (camera == rig_camera_index.end() || !rig.cam_from_rig[camera->second]) {
+    *error = "the image " + image.Name() +
+             " of a rig frame is not of a calibrated rig camera";
+    return false;
+  }
+  if (!in_rig_frame->insert(image_id).second) {
+    *error = "the image " + image.Name() + " is in two rig frames";
+    return false;
+  }
+  // COLMAP >= 3.12 recomputes the pose from the frame; the model must
+  // agree so that COLMAP 3.8 and later show the same poses.
+  const Rigid3d expected = *rig.cam_from_rig[camera->second] * rig_from_world;
+  const Rigid3d stored = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
+  if ((expected.RotationMatrix() - stored.RotationMatrix()).norm() > 1e-9 ||
+      (expected.translation - stored.translation).norm() >
+          1e-9 * std::max(1.0, expected.translation.norm())) {
+    *error = "the pose of the image " + image.Name() +
+             " differs from cam_from_rig * rig_from_world";
+    return false;
+  }
+  return true;
+}
+
+// The frames of the rig (ids max_image_id + 1, ...), their images sorted by
+// camera id; *in_rig_frame gets their images.
+bool MakeRigFrames(
+    const colmap::Reconstruction& model, const ModelRig& rig,
+    const std::unordered_map<colmap::camera_t, int>& rig_camera_index,
+    colmap::image_t max_image_id, uint32_t rig_id,
+    std::unordered_set<colmap::image_t>* in_rig_frame,
+    std::vector<ColmapFrame>* rig_frames, std::string* error) {
   for (size_t f = 0; f < rig.frames.size(); ++f) {
     const ModelRig::Frame& rig_frame = rig.frames[f];
     if (rig_frame.image_ids.empty()) {
@@ -375,47 +381,33 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
     }
     ColmapFrame frame;
     frame.frame_id = max_image_id + 1 + static_cast<colmap::image_t>(f);
-    frame.rig_id = calibrated.rig_id;
+    frame.rig_id = rig_id;
     frame.rig_from_world = rig_frame.rig_from_world;
     for (const colmap::image_t image_id : rig_frame.image_ids) {
-      if (!model.ExistsImage(image_id) || !model.IsImageRegistered(image_id)) {
-        *error = "the rig frame image " + std::to_string(image_id) +
-                 " is not a registered image of the model";
+      if (!CheckRigFrameImage(model, rig, rig_camera_index,
+                              rig_frame.rig_from_world, image_id, in_rig_frame,
+                              error)) {
         return false;
       }
-      const colmap::Image& image = model.Image(image_id);
-      const auto camera = rig_camera_index.find(image.CameraId());
-      if (camera == rig_camera_index.end() ||
-          !rig.cam_from_rig[camera->second]) {
-        *error = "the image " + image.Name() +
-                 " of a rig frame is not of a calibrated rig camera";
-        return false;
-      }
-      if (!in_rig_frame.insert(image_id).second) {
-        *error = "the image " + image.Name() + " is in two rig frames";
-        return false;
-      }
-      // COLMAP >= 3.12 recomputes the pose from the frame; the model must
-      // agree so that COLMAP 3.8 and later show the same poses.
-      const Rigid3d expected =
-          *rig.cam_from_rig[camera->second] * rig_frame.rig_from_world;
-      const Rigid3d stored = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
-      if ((expected.RotationMatrix() - stored.RotationMatrix()).norm() > 1e-9 ||
-          (expected.translation - stored.translation).norm() >
-              1e-9 * std::max(1.0, expected.translation.norm())) {
-        *error = "the pose of the image " + image.Name() +
-                 " differs from cam_from_rig * rig_from_world";
-        return false;
-      }
-      frame.data.push_back({{kSensorCamera, image.CameraId()}, image_id});
+      frame.data.push_back(
+          {{kSensorCamera, model.Image(image_id).CameraId()}, image_id});
     }
     std::sort(frame.data.begin(), frame.data.end(),
               [](const ColmapFrameData& a, const ColmapFrameData& b) {
                 return a.sensor.id < b.sensor.id;
               });
-    rig_frames.push_back(std::move(frame));
+    rig_frames->push_back(std::move(frame));
   }
+  return true;
+}
 
+// A trivial frame (id = image id) for every registered image outside the rig
+// frames, sorted by id; fails for an image of a rig camera.
+bool AddTrivialFrames(
+    const colmap::Reconstruction& model,
+    const std::unordered_map<colmap::camera_t, int>& rig_camera_index,
+    const std::unordered_set<colmap::image_t>& in_rig_frame,
+    ColmapRigsAndFrames* rigs_frames, std::string* error) {
   std::vector<colmap::image_t> image_ids = model.RegImageIds();
   std::sort(image_ids.begin(), image_ids.end());
   for (const colmap::image_t image_id : image_ids) {
@@ -433,59 +425,49 @@ bool BuildRigsAndFrames(const colmap::Reconstruction& model,
     trivial.data.push_back({{kSensorCamera, image.CameraId()}, image_id});
     rigs_frames->frames.push_back(std::move(trivial));
   }
-  for (ColmapFrame& frame : rig_frames) {
-    rigs_frames->frames.push_back(std::move(frame));
-  }
   return true;
 }
 
-bool WriteRigsAndFrames(const std::string& folder,
-                        const ColmapRigsAndFrames& rigs_frames, bool binary,
-                        std::string* error) {
+bool WriteRigsAndFramesBinary(const std::string& folder,
+                              const ColmapRigsAndFrames& rigs_frames,
+                              std::string* error) {
+  std::string rigs;
+  AppendBinary<uint64_t>(rigs_frames.rigs.size(), &rigs);
   for (const ColmapRig& rig : rigs_frames.rigs) {
+    AppendBinary<uint32_t>(rig.rig_id, &rigs);
+    AppendBinary<uint32_t>(static_cast<uint32_t>(rig.sensors.size() + 1),
+                           &rigs);
+    AppendBinary<int32_t>(rig.ref_sensor.type, &rigs);
+    AppendBinary<uint32_t>(rig.ref_sensor.id, &rigs);
     for (const ColmapRigSensor& sensor : rig.sensors) {
-      if (SameSensor(sensor.sensor, rig.ref_sensor)) {
-        *error = "the rig " + std::to_string(rig.rig_id) +
-                 " lists its reference sensor twice";
-        return false;
+      AppendBinary<int32_t>(sensor.sensor.type, &rigs);
+      AppendBinary<uint32_t>(sensor.sensor.id, &rigs);
+      AppendBinary<uint8_t>(sensor.sensor_from_rig ? 1 : 0, &rigs);
+      if (sensor.sensor_from_rig) {
+        AppendPoseBinary(*sensor.sensor_from_rig, &rigs);
       }
     }
   }
-  if (binary) {
-    std::string rigs;
-    AppendBinary<uint64_t>(rigs_frames.rigs.size(), &rigs);
-    for (const ColmapRig& rig : rigs_frames.rigs) {
-      AppendBinary<uint32_t>(rig.rig_id, &rigs);
-      AppendBinary<uint32_t>(static_cast<uint32_t>(rig.sensors.size() + 1),
-                             &rigs);
-      AppendBinary<int32_t>(rig.ref_sensor.type, &rigs);
-      AppendBinary<uint32_t>(rig.ref_sensor.id, &rigs);
-      for (const ColmapRigSensor& sensor : rig.sensors) {
-        AppendBinary<int32_t>(sensor.sensor.type, &rigs);
-        AppendBinary<uint32_t>(sensor.sensor.id, &rigs);
-        AppendBinary<uint8_t>(sensor.sensor_from_rig ? 1 : 0, &rigs);
-        if (sensor.sensor_from_rig) {
-          AppendPoseBinary(*sensor.sensor_from_rig, &rigs);
-        }
-      }
+  std::string frames;
+  AppendBinary<uint64_t>(rigs_frames.frames.size(), &frames);
+  for (const ColmapFrame& frame : rigs_frames.frames) {
+    AppendBinary<uint32_t>(frame.frame_id, &frames);
+    AppendBinary<uint32_t>(frame.rig_id, &frames);
+    AppendPoseBinary(frame.rig_from_world, &frames);
+    AppendBinary<uint32_t>(static_cast<uint32_t>(frame.data.size()), &frames);
+    for (const ColmapFrameData& data : frame.data) {
+      AppendBinary<int32_t>(data.sensor.type, &frames);
+      AppendBinary<uint32_t>(data.sensor.id, &frames);
+      AppendBinary<uint64_t>(data.data_id, &frames);
     }
-    std::string frames;
-    AppendBinary<uint64_t>(rigs_frames.frames.size(), &frames);
-    for (const ColmapFrame& frame : rigs_frames.frames) {
-      AppendBinary<uint32_t>(frame.frame_id, &frames);
-      AppendBinary<uint32_t>(frame.rig_id, &frames);
-      AppendPoseBinary(frame.rig_from_world, &frames);
-      AppendBinary<uint32_t>(static_cast<uint32_t>(frame.data.size()), &frames);
-      for (const ColmapFrameData& data : frame.data) {
-        AppendBinary<int32_t>(data.sensor.type, &frames);
-        AppendBinary<uint32_t>(data.sensor.id, &frames);
-        AppendBinary<uint64_t>(data.data_id, &frames);
-      }
-    }
-    return WriteFileAtomically(folder + "/rigs.bin", rigs, error) &&
-           WriteFileAtomically(folder + "/frames.bin", frames, error);
   }
+  return WriteFileAtomically(folder + "/rigs.bin", rigs, error) &&
+         WriteFileAtomically(folder + "/frames.bin", frames, error);
+}
 
+bool WriteRigsAndFramesText(const std::string& folder,
+                            const ColmapRigsAndFrames& rigs_frames,
+                            std::string* error) {
   std::ostringstream rigs;
   rigs.precision(17);
   rigs << "# Rig calib list with one line of data per calib:\n"
@@ -526,6 +508,74 @@ bool WriteRigsAndFrames(const std::string& folder,
   }
   return WriteFileAtomically(folder + "/rigs.txt", rigs.str(), error) &&
          WriteFileAtomically(folder + "/frames.txt", frames.str(), error);
+}
+
+}  // namespace
+
+bool BuildRigsAndFrames(const colmap::Reconstruction& model,
+                        const ModelRig& rig, ColmapRigsAndFrames* rigs_frames,
+                        std::string* error) {
+  *rigs_frames = ColmapRigsAndFrames();
+  const int num_rig_cameras = static_cast<int>(rig.camera_ids.size());
+  if (num_rig_cameras == 0 || rig.reference_camera < 0 ||
+      rig.reference_camera >= num_rig_cameras ||
+      static_cast<int>(rig.cam_from_rig.size()) != num_rig_cameras) {
+    *error =
+        "the rig has no cameras, or its reference camera or poses do "
+        "not match its cameras";
+    return false;
+  }
+  std::unordered_map<colmap::camera_t, int> rig_camera_index;
+  for (int c = 0; c < num_rig_cameras; ++c) {
+    if (!model.ExistsCamera(rig.camera_ids[c]) ||
+        !rig_camera_index.emplace(rig.camera_ids[c], c).second) {
+      *error = "the rig camera id " + std::to_string(rig.camera_ids[c]) +
+               " is not in the model or appears twice";
+      return false;
+    }
+  }
+
+  const colmap::camera_t max_camera_id = MaxCameraId(model);
+  const colmap::image_t max_image_id = MaxImageId(model);
+  if (static_cast<uint64_t>(max_camera_id) + 1 >=
+          std::numeric_limits<uint32_t>::max() ||
+      static_cast<uint64_t>(max_image_id) + rig.frames.size() >=
+          std::numeric_limits<uint32_t>::max()) {
+    *error = "the model's ids leave no room for the rig's rig and frame ids";
+    return false;
+  }
+  const uint32_t calibrated_rig_id = max_camera_id + 1;
+  AddRigs(model, rig, rig_camera_index, calibrated_rig_id, rigs_frames);
+  // Rig frames first, to know which images they hold; they are listed after
+  // the trivial frames.
+  std::unordered_set<colmap::image_t> in_rig_frame;
+  std::vector<ColmapFrame> rig_frames;
+  if (!MakeRigFrames(model, rig, rig_camera_index, max_image_id,
+                     calibrated_rig_id, &in_rig_frame, &rig_frames, error) ||
+      !AddTrivialFrames(model, rig_camera_index, in_rig_frame, rigs_frames,
+                        error)) {
+    return false;
+  }
+  for (ColmapFrame& frame : rig_frames) {
+    rigs_frames->frames.push_back(std::move(frame));
+  }
+  return true;
+}
+
+bool WriteRigsAndFrames(const std::string& folder,
+                        const ColmapRigsAndFrames& rigs_frames, bool binary,
+                        std::string* error) {
+  for (const ColmapRig& rig : rigs_frames.rigs) {
+    for (const ColmapRigSensor& sensor : rig.sensors) {
+      if (SameSensor(sensor.sensor, rig.ref_sensor)) {
+        *error = "the rig " + std::to_string(rig.rig_id) +
+                 " lists its reference sensor twice";
+        return false;
+      }
+    }
+  }
+  return binary ? WriteRigsAndFramesBinary(folder, rigs_frames, error)
+                : WriteRigsAndFramesText(folder, rigs_frames, error);
 }
 
 bool ReadRigsAndFrames(const std::string& folder,

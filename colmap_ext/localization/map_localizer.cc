@@ -1,43 +1,43 @@
 #include "colmap_ext/localization/map_localizer.h"
 
+#include <colmap/util/timer.h>
 #include <glog/logging.h>
 #include <omp.h>
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
+
+#include "colmap_ext/io/name_table.h"
 
 namespace rig_calibrator {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(const Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+// What to do about a rig image or its features missing from the database.
+constexpr char kFeatureExtractorHint[] =
+    ": run colmap feature_extractor on the rig images into this database "
+    "first (see README)";
 
 std::string MissingImageMessage(const DatabaseReader& database,
                                 const std::string& name) {
   return "the database " + database.path() + " has no image named " + name +
-         ": run colmap feature_extractor on the rig images into this "
-         "database first (see README)";
+         kFeatureExtractorHint;
+}
+
+const NameTable<LocalizationMode>& LocalizationModeNames() {
+  static const NameTable<LocalizationMode> names = {
+      {LocalizationMode::kDirect, "direct"},
+      {LocalizationMode::kRetrieval, "retrieval"}};
+  return names;
 }
 
 }  // namespace
 
 bool LocalizationModeFromName(const std::string& name, LocalizationMode* mode) {
-  if (name == "direct") {
-    *mode = LocalizationMode::kDirect;
-  } else if (name == "retrieval") {
-    *mode = LocalizationMode::kRetrieval;
-  } else {
-    return false;
-  }
-  return true;
+  return ValueFromName(LocalizationModeNames(), name, mode);
 }
 
 std::string LocalizationModeName(const LocalizationMode mode) {
-  return mode == LocalizationMode::kDirect ? "direct" : "retrieval";
+  return NameOfValue(LocalizationModeNames(), mode, "unknown");
 }
 
 std::string CorrespondenceSourceName(const CorrespondenceSource source) {
@@ -102,7 +102,8 @@ std::unique_ptr<MapLocalizer> MapLocalizer::Create(
     return nullptr;
   }
   std::unique_ptr<MapLocalizer> localizer(new MapLocalizer(options, database));
-  const Clock::time_point start = Clock::now();
+  colmap::Timer timer;
+  timer.Start();
   if (!ReadLocalizationMap(map, *database, &localizer->map_, error) ||
       !IndexTrackDescriptors(
           localizer->map_, *database, options.max_descriptors_per_point,
@@ -129,7 +130,7 @@ std::unique_ptr<MapLocalizer> MapLocalizer::Create(
             << localizer->NumIndexedDescriptors() << " point descriptors"
             << (needs_search_index ? " in a kd-tree index" : "")
             << (localizer->vocab_tree_ != nullptr ? ", vocabulary tree" : "")
-            << "; ready in " << SecondsSince(start) << " s";
+            << "; ready in " << timer.ElapsedSeconds() << " s";
   return localizer;
 }
 
@@ -137,9 +138,7 @@ bool MapLocalizer::CheckImageFeatures(const DatabaseImage& image,
                                       std::string* error) const {
   const int num_keypoints = database_->NumKeypoints(image.image_id);
   const int num_descriptors = database_->NumDescriptors(image.image_id);
-  const std::string hint =
-      ": run colmap feature_extractor on the rig images into this database "
-      "first (see README)";
+  const std::string hint = kFeatureExtractorHint;
   if (num_keypoints < 0) {
     *error = "the database " + database_->path() +
              " has no keypoints for image " + image.name + hint;
@@ -201,14 +200,15 @@ bool MapLocalizer::LocalizeImages(const std::vector<std::string>& image_names,
   results->assign(num_images, ImageLocalization());
   std::vector<std::string> errors(num_images);
   std::atomic<int> num_done(0);
-  const Clock::time_point start = Clock::now();
+  colmap::Timer timer;
+  timer.Start();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
   for (int i = 0; i < num_images; ++i) {
     LocalizeImage(*images[i], &(*results)[i], &errors[i]);
     const int done = ++num_done;
     if (options_.progress_interval > 0 &&
         (done % options_.progress_interval == 0 || done == num_images)) {
-      const double seconds = SecondsSince(start);
+      const double seconds = timer.ElapsedSeconds();
       LOG(INFO) << "localized " << done << "/" << num_images << " images, "
                 << (seconds > 0 ? done / seconds : 0.0) << " images/s";
     }
@@ -227,7 +227,7 @@ bool MapLocalizer::LocalizeImages(const std::vector<std::string>& image_names,
     num_empty += result.correspondences.empty() ? 1 : 0;
   }
   LOG(INFO) << "Localized " << num_images << " images in "
-            << SecondsSince(start) << " s: " << num_correspondences
+            << timer.ElapsedSeconds() << " s: " << num_correspondences
             << " 2D-3D correspondences, " << num_empty << " images without any";
   return true;
 }
@@ -235,7 +235,8 @@ bool MapLocalizer::LocalizeImages(const std::vector<std::string>& image_names,
 bool MapLocalizer::LocalizeImage(const DatabaseImage& image,
                                  ImageLocalization* result,
                                  std::string* error) const {
-  const Clock::time_point start = Clock::now();
+  colmap::Timer timer;
+  timer.Start();
   *result = ImageLocalization();
   result->image_name = image.name;
   result->image_id = image.image_id;
@@ -302,7 +303,7 @@ bool MapLocalizer::LocalizeImage(const DatabaseImage& image,
     result->correspondences.push_back(correspondence);
     result->point2D_idxs.push_back(candidate.point2D_idx);
   }
-  result->seconds = SecondsSince(start);
+  result->seconds = timer.ElapsedSeconds();
   return true;
 }
 

@@ -16,18 +16,8 @@ namespace {
 bool CheckInput(const FinalBundleAdjustmentOptions& options,
                 const RigDataset& dataset, const RigCalibration& calibration) {
   std::string error;
-  if (!ValidateDataset(dataset, &error)) {
+  if (!ValidateCalibration(dataset, calibration, &error)) {
     LOG(ERROR) << "Final bundle adjustment: " << error;
-    return false;
-  }
-  const size_t num_cameras = dataset.cameras.size();
-  if (calibration.cameras.size() != num_cameras ||
-      calibration.cam_from_rig.size() != num_cameras ||
-      calibration.camera_calibrated.size() != num_cameras ||
-      calibration.rig_from_world.size() != dataset.frameset_names.size() ||
-      calibration.images.size() != dataset.images.size()) {
-    LOG(ERROR) << "Final bundle adjustment: the calibration does not match "
-                  "the dataset (numbers of cameras, framesets or images)";
     return false;
   }
   if (!(options.loss_scale_px > 0) || options.max_num_iterations < 1 ||
@@ -38,24 +28,13 @@ bool CheckInput(const FinalBundleAdjustmentOptions& options,
                   "iterations, outlier thresholds or pruning rounds)";
     return false;
   }
-  for (size_t camera = 0; camera < num_cameras; ++camera) {
+  for (size_t camera = 0; camera < dataset.cameras.size(); ++camera) {
     const colmap::Camera& intrinsics = calibration.cameras[camera];
     if (calibration.camera_calibrated[camera] &&
         (!colmap::ExistsCameraModelWithId(intrinsics.ModelId()) ||
          !intrinsics.VerifyParams())) {
       LOG(ERROR) << "Final bundle adjustment: camera " << camera
                  << " has an unknown model or a wrong number of parameters";
-      return false;
-    }
-  }
-  for (size_t i = 0; i < dataset.images.size(); ++i) {
-    const std::vector<char>& mask = calibration.images[i].inlier_mask;
-    if (!mask.empty() &&
-        mask.size() != dataset.images[i].correspondences.size()) {
-      LOG(ERROR) << "Final bundle adjustment: the inlier mask of image "
-                 << dataset.images[i].name << " has " << mask.size()
-                 << " entries for " << dataset.images[i].correspondences.size()
-                 << " correspondences";
       return false;
     }
   }

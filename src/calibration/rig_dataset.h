@@ -80,4 +80,12 @@ struct RigCalibration {
 // camera or image and what is wrong.
 bool ValidateDataset(const RigDataset& dataset, std::string* error);
 
+// ValidateDataset, and a calibration shaped like the dataset: one entry per
+// camera (intrinsics, cam_from_rig, calibrated flag), per frameset
+// (rig_from_world) and per image (result); finite cam_from_rig and
+// rig_from_world; every non-empty inlier mask one flag per correspondence.
+// Returns false with `error` naming the camera, frameset or image.
+bool ValidateCalibration(const RigDataset& dataset,
+                         const RigCalibration& calibration, std::string* error);
+
 }  // namespace rig_calibrator

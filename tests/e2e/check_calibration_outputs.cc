@@ -36,6 +36,7 @@
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rigs_frames_io.h"
 #include "src/geometry/rigid3d.h"
+#include "tests/e2e/calibration_output.h"
 
 namespace rig_calibrator {
 namespace {
@@ -54,186 +55,6 @@ constexpr double kExactKalibrTolerancePx = 1e-6;
 // (the file keeps every number exactly), so only the order of floating-point
 // sums in multi-threaded Ceres differs.
 constexpr double kRerunTolerance = 1e-6;
-
-int g_num_failed = 0;
-
-// Prints "[check] <name>: <details>: ok|FAILED" and counts failures.
-void Report(const std::string& name, const std::string& details, bool ok) {
-  std::cout << "[check] " << name << ": " << details << ": "
-            << (ok ? "ok" : "FAILED") << std::endl;
-  if (!ok) ++g_num_failed;
-}
-
-std::string Number(const double value) {
-  std::ostringstream text;
-  text.precision(3);
-  text << value;
-  return text.str();
-}
-
-[[noreturn]] void Die(const std::string& message) {
-  std::cerr << "[check] ERROR: " << message << std::endl;
-  std::exit(2);
-}
-
-// Rotation angle between two rotations (radians), accurate for tiny angles:
-// 2 asin(|v|) of the vector part v of a^-1 b.
-double RotationAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  const Eigen::Quaterniond difference = a.conjugate() * b;
-  return 2 * std::asin(std::min(1.0, difference.vec().norm()));
-}
-
-struct PoseDifference {
-  double rotation_rad = 0;
-  double translation = 0;
-  void Max(const Rigid3d& a, const Rigid3d& b) {
-    rotation_rad =
-        std::max(rotation_rad, RotationAngle(a.rotation, b.rotation));
-    translation = std::max(translation, (a.translation - b.translation).norm());
-  }
-  std::string Text(const std::string& translation_unit = "") const {
-    return "rotation " + Number(rotation_rad) + " rad, translation " +
-           Number(translation) + translation_unit;
-  }
-};
-
-double RelativeDifference(const double a, const double b) {
-  return std::abs(a - b) / std::max(1.0, std::abs(a));
-}
-
-Rigid3d ImagePose(const colmap::Image& image) {
-  return Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
-}
-
-// One camera of calibration_summary.json.
-struct SummaryCamera {
-  std::string name;
-  std::string image_prefix;
-  bool calibrated = false;
-  colmap::Camera camera;
-  std::optional<Rigid3d> cam_from_rig;
-  int num_used = 0;
-};
-
-struct Summary {
-  std::string method;
-  std::string reference_camera;
-  int num_framesets_used = 0;
-  std::vector<SummaryCamera> cameras;
-};
-
-Summary ReadSummary(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) Die("cannot read " + path);
-  Summary summary;
-  try {
-    const nlohmann::json json = nlohmann::json::parse(file);
-    summary.method = json.at("method").get<std::string>();
-    summary.reference_camera = json.at("reference_camera").get<std::string>();
-    summary.num_framesets_used = json.at("num_framesets_used").get<int>();
-    for (const nlohmann::json& node : json.at("cameras")) {
-      SummaryCamera camera;
-      camera.name = node.at("name").get<std::string>();
-      camera.image_prefix = node.at("image_prefix").get<std::string>();
-      camera.calibrated = node.at("calibrated").get<bool>();
-      camera.num_used = node.at("num_used").get<int>();
-      const std::string model = node.at("model").get<std::string>();
-      if (!colmap::ExistsCameraModelWithName(model)) {
-        Die(path + ": unknown camera model " + model);
-      }
-      camera.camera.SetModelIdFromName(model);
-      camera.camera.SetWidth(node.at("width").get<size_t>());
-      camera.camera.SetHeight(node.at("height").get<size_t>());
-      camera.camera.SetParams(node.at("params").get<std::vector<double>>());
-      if (!camera.camera.VerifyParams()) {
-        Die(path + ": wrong number of parameters for camera " + camera.name);
-      }
-      const nlohmann::json& pose = node.at("cam_from_rig");
-      if (!pose.is_null()) {
-        const std::vector<double> q =
-            pose.at("rotation_wxyz").get<std::vector<double>>();
-        const std::vector<double> t =
-            pose.at("translation").get<std::vector<double>>();
-        if (q.size() != 4 || t.size() != 3) Die(path + ": malformed pose");
-        camera.cam_from_rig =
-            Rigid3d::FromQvecTvec(Eigen::Vector4d(q[0], q[1], q[2], q[3]),
-                                  Eigen::Vector3d(t[0], t[1], t[2]));
-      }
-      summary.cameras.push_back(camera);
-    }
-  } catch (const std::exception& exception) {
-    Die(path + ": " + exception.what());
-  }
-  return summary;
-}
-
-colmap::Reconstruction ReadModel(const std::string& folder) {
-  colmap::Reconstruction model;
-  if (fs::exists(folder + "/cameras.bin")) {
-    model.ReadBinary(folder);
-  } else if (fs::exists(folder + "/cameras.txt")) {
-    model.ReadText(folder);
-  } else {
-    Die("no COLMAP model (cameras.bin or cameras.txt) in " + folder);
-  }
-  return model;
-}
-
-// The largest pixel distance between `a` and `b` over a grid of pixels:
-// each pixel is lifted to a ray with `a` and projected with `b`.
-double MaxProjectionDifferencePx(const colmap::Camera& a,
-                                 const colmap::Camera& b) {
-  constexpr int kGrid = 20;
-  double max_difference = 0;
-  for (int i = 0; i <= kGrid; ++i) {
-    for (int j = 0; j <= kGrid; ++j) {
-      const Eigen::Vector2d pixel(0.5 + (a.Width() - 1.0) * i / kGrid,
-                                  0.5 + (a.Height() - 1.0) * j / kGrid);
-      const Eigen::Vector2d ray = a.ImageToWorld(pixel);
-      max_difference =
-          std::max(max_difference, (b.WorldToImage(ray) - pixel).norm());
-    }
-  }
-  return max_difference;
-}
-
-// Kalibr has an exact equivalent of these COLMAP models (camchain_io.h).
-bool MapsExactlyToKalibr(const colmap::Camera& camera) {
-  static const std::set<std::string> kExact = {"SIMPLE_PINHOLE",
-                                               "PINHOLE",
-                                               "SIMPLE_RADIAL",
-                                               "RADIAL",
-                                               "OPENCV",
-                                               "OPENCV_FISHEYE",
-                                               "FOV",
-                                               "SIMPLE_RADIAL_FISHEYE",
-                                               "RADIAL_FISHEYE"};
-  return kExact.count(camera.ModelName()) > 0;
-}
-
-// The model's camera of the rig camera with `image_prefix`: the camera of
-// its registered images (which must all share it).
-std::optional<colmap::camera_t> ModelCameraOfPrefix(
-    const colmap::Reconstruction& model, const std::string& image_prefix,
-    int* num_images) {
-  std::set<colmap::camera_t> camera_ids;
-  *num_images = 0;
-  for (const colmap::image_t image_id : model.RegImageIds()) {
-    const colmap::Image& image = model.Image(image_id);
-    if (image.Name().compare(0, image_prefix.size(), image_prefix) == 0) {
-      camera_ids.insert(image.CameraId());
-      ++*num_images;
-    }
-  }
-  if (camera_ids.size() != 1) return std::nullopt;
-  return *camera_ids.begin();
-}
-
-struct Output {
-  std::string folder;
-  colmap::Reconstruction model;
-  Summary summary;
-};
 
 void CheckModel(const Output& output) {
   const Summary& summary = output.summary;
@@ -288,13 +109,54 @@ void CheckModel(const Output& output) {
          ok);
 }
 
-void CheckRigsAndFrames(const Output& output) {
-  ColmapRigsAndFrames rigs_frames;
-  std::string error;
-  if (!ReadRigsAndFrames(output.folder, &rigs_frames, &error)) {
-    Report("rigs/frames parse", error, false);
-    return;
+// Adds the differences between the images' poses and cam_from_rig *
+// rig_from_world of `frame` to *composition and counts the frames of each
+// image; false for an image that is not in the model or whose camera has
+// no pose in the rig.
+bool AddFrameCompositions(const colmap::Reconstruction& model,
+                          const ColmapFrame& frame, const ColmapRig& rig,
+                          PoseDifference* composition,
+                          std::map<colmap::image_t, int>* frames_of_image) {
+  bool ok = true;
+  for (const ColmapFrameData& data : frame.data) {
+    if (data.sensor.type != kSensorCamera ||
+        !model.ExistsImage(static_cast<colmap::image_t>(data.data_id))) {
+      std::cout << "[check]   frame " << frame.frame_id << ": image "
+                << data.data_id << " is not in the model" << std::endl;
+      ok = false;
+      continue;
+    }
+    const colmap::Image& image =
+        model.Image(static_cast<colmap::image_t>(data.data_id));
+    ++(*frames_of_image)[image.ImageId()];
+    std::optional<Rigid3d> cam_from_rig;
+    if (rig.ref_sensor.type == kSensorCamera &&
+        rig.ref_sensor.id == data.sensor.id) {
+      cam_from_rig = Rigid3d();
+    }
+    for (const ColmapRigSensor& sensor : rig.sensors) {
+      if (sensor.sensor.type == kSensorCamera &&
+          sensor.sensor.id == data.sensor.id) {
+        cam_from_rig = sensor.sensor_from_rig;
+      }
+    }
+    if (!cam_from_rig || data.sensor.id != image.CameraId()) {
+      std::cout << "[check]   image " << image.Name()
+                << ": its camera has no pose in rig " << frame.rig_id
+                << std::endl;
+      ok = false;
+      continue;
+    }
+    composition->Max(ImagePose(image), *cam_from_rig * frame.rig_from_world);
   }
+  return ok;
+}
+
+// Every registered image in exactly one frame, each pose cam_from_rig *
+// rig_from_world of its frame; one multi-camera rig, returned (nullptr if
+// none).
+const ColmapRig* CheckFrames(const Output& output,
+                             const ColmapRigsAndFrames& rigs_frames) {
   const colmap::Reconstruction& model = output.model;
   std::map<uint32_t, const ColmapRig*> rigs;
   for (const ColmapRig& rig : rigs_frames.rigs) rigs[rig.rig_id] = &rig;
@@ -318,37 +180,9 @@ void CheckRigsAndFrames(const Output& output) {
       continue;
     }
     num_rig_frames += rig->second == calibrated_rig ? 1 : 0;
-    for (const ColmapFrameData& data : frame.data) {
-      if (data.sensor.type != kSensorCamera ||
-          !model.ExistsImage(static_cast<colmap::image_t>(data.data_id))) {
-        std::cout << "[check]   frame " << frame.frame_id << ": image "
-                  << data.data_id << " is not in the model" << std::endl;
-        ok = false;
-        continue;
-      }
-      const colmap::Image& image =
-          model.Image(static_cast<colmap::image_t>(data.data_id));
-      ++frames_of_image[image.ImageId()];
-      std::optional<Rigid3d> cam_from_rig;
-      if (rig->second->ref_sensor.type == kSensorCamera &&
-          rig->second->ref_sensor.id == data.sensor.id) {
-        cam_from_rig = Rigid3d();
-      }
-      for (const ColmapRigSensor& sensor : rig->second->sensors) {
-        if (sensor.sensor.type == kSensorCamera &&
-            sensor.sensor.id == data.sensor.id) {
-          cam_from_rig = sensor.sensor_from_rig;
-        }
-      }
-      if (!cam_from_rig || data.sensor.id != image.CameraId()) {
-        std::cout << "[check]   image " << image.Name()
-                  << ": its camera has no pose in rig " << frame.rig_id
-                  << std::endl;
-        ok = false;
-        continue;
-      }
-      composition.Max(ImagePose(image), *cam_from_rig * frame.rig_from_world);
-    }
+    ok = AddFrameCompositions(model, frame, *rig->second, &composition,
+                              &frames_of_image) &&
+         ok;
   }
   for (const colmap::image_t image_id : model.RegImageIds()) {
     if (frames_of_image[image_id] != 1) {
@@ -371,12 +205,15 @@ void CheckRigsAndFrames(const Output& output) {
              " images, max difference " + composition.Text() +
              " (<= " + Number(kPoseCompositionTolerance) + ")",
          ok);
-  if (calibrated_rig == nullptr) return;
+  return calibrated_rig;
+}
 
-  // The calibrated rig's sensors are the summary's cam_from_rig.
+// The calibrated rig's sensors are the summary's cam_from_rig.
+void CheckCalibratedRig(const Output& output, const ColmapRig& calibrated_rig) {
+  const colmap::Reconstruction& model = output.model;
   PoseDifference rig_difference;
   int num_matched = 0;
-  ok = true;
+  bool ok = true;
   for (const SummaryCamera& camera : output.summary.cameras) {
     if (!camera.calibrated) continue;
     int num_images = 0;
@@ -387,11 +224,11 @@ void CheckRigsAndFrames(const Output& output) {
       continue;
     }
     std::optional<Rigid3d> cam_from_rig;
-    if (calibrated_rig->ref_sensor.id == *camera_id) {
+    if (calibrated_rig.ref_sensor.id == *camera_id) {
       cam_from_rig = Rigid3d();
       ok = ok && camera.name == output.summary.reference_camera;
     }
-    for (const ColmapRigSensor& sensor : calibrated_rig->sensors) {
+    for (const ColmapRigSensor& sensor : calibrated_rig.sensors) {
       if (sensor.sensor.id == *camera_id) cam_from_rig = sensor.sensor_from_rig;
     }
     if (!cam_from_rig) {
@@ -409,6 +246,17 @@ void CheckRigsAndFrames(const Output& output) {
          std::to_string(num_matched) + " cameras, max difference " +
              rig_difference.Text(),
          ok);
+}
+
+void CheckRigsAndFrames(const Output& output) {
+  ColmapRigsAndFrames rigs_frames;
+  std::string error;
+  if (!ReadRigsAndFrames(output.folder, &rigs_frames, &error)) {
+    Report("rigs/frames parse", error, false);
+    return;
+  }
+  const ColmapRig* calibrated_rig = CheckFrames(output, rigs_frames);
+  if (calibrated_rig != nullptr) CheckCalibratedRig(output, *calibrated_rig);
 }
 
 void CheckRigConfig(const Output& output) {
@@ -525,8 +373,9 @@ void CheckCamchain(const Output& output) {
          ok);
 }
 
-// The re-run reproduces the reference run.
-void CompareWithReference(const Output& output, const Output& reference) {
+// The re-run has the reference run's cameras, intrinsics and cam_from_rig.
+void CompareCamerasWithReference(const Output& output,
+                                 const Output& reference) {
   bool ok =
       output.summary.cameras.size() == reference.summary.cameras.size() &&
       output.summary.reference_camera == reference.summary.reference_camera &&
@@ -568,8 +417,10 @@ void CompareWithReference(const Output& output, const Output& reference) {
              Number(rig_translation) +
              " of the rig size (<= " + Number(kRerunTolerance) + ")",
          ok);
+}
 
-  // Registered image poses, matched by name, relative to the scene size.
+// Registered image poses, matched by name, relative to the scene size.
+void ComparePosesWithReference(const Output& output, const Output& reference) {
   std::map<std::string, Rigid3d> reference_poses;
   for (const colmap::image_t image_id : reference.model.RegImageIds()) {
     const colmap::Image& image = reference.model.Image(image_id);
@@ -578,7 +429,7 @@ void CompareWithReference(const Output& output, const Output& reference) {
   PoseDifference pose_difference;
   double max_center_difference = 0;
   double scene_scale = 0;
-  ok = output.model.NumRegImages() == reference_poses.size();
+  bool ok = output.model.NumRegImages() == reference_poses.size();
   for (const colmap::image_t image_id : output.model.RegImageIds()) {
     const colmap::Image& image = output.model.Image(image_id);
     const auto it = reference_poses.find(image.Name());
@@ -608,15 +459,6 @@ void CompareWithReference(const Output& output, const Output& reference) {
          ok);
 }
 
-Output ReadOutput(const std::string& folder) {
-  if (!fs::is_directory(folder)) Die("no output folder " + folder);
-  Output output;
-  output.folder = folder;
-  output.model = ReadModel(folder);
-  output.summary = ReadSummary(folder + "/calibration_summary.json");
-  return output;
-}
-
 }  // namespace
 }  // namespace rig_calibrator
 
@@ -637,11 +479,15 @@ int main(int argc, char** argv) {
   CheckRigsAndFrames(output);
   CheckRigConfig(output);
   CheckCamchain(output);
-  if (argc == 3) CompareWithReference(output, ReadOutput(argv[2]));
-  std::cout << "[check] " << (g_num_failed == 0 ? "all checks passed" : "")
-            << (g_num_failed > 0
-                    ? std::to_string(g_num_failed) + " check(s) FAILED"
+  if (argc == 3) {
+    const Output reference = ReadOutput(argv[2]);
+    CompareCamerasWithReference(output, reference);
+    ComparePosesWithReference(output, reference);
+  }
+  std::cout << "[check] " << (NumFailedChecks() == 0 ? "all checks passed" : "")
+            << (NumFailedChecks() > 0
+                    ? std::to_string(NumFailedChecks()) + " check(s) FAILED"
                     : "")
             << std::endl;
-  return g_num_failed == 0 ? 0 : 1;
+  return NumFailedChecks() == 0 ? 0 : 1;
 }

@@ -22,27 +22,35 @@ SyntheticMapDatabaseOptions SmallOptions() {
   return options;
 }
 
+// A database written from SmallOptions into scene.db.
+class SyntheticMapDatabaseTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(WriteSyntheticMapDatabase(options_, temp_dir_.File("scene.db"),
+                                          &scene_, &error_))
+        << error_;
+  }
+
+  testing::ScopedTempDir temp_dir_;
+  const SyntheticMapDatabaseOptions options_ = SmallOptions();
+  SyntheticMapDatabase scene_;
+  std::string error_;
+};
+
 // The database holds what the options say, the map's tracks point at
 // keypoints of the database images, and the planted rig keypoints are the
 // projections of their map points.
-TEST(SyntheticMapDatabase, DatabaseMatchesMapAndRigGeometry) {
-  testing::ScopedTempDir temp_dir;
-  const SyntheticMapDatabaseOptions options = SmallOptions();
-  SyntheticMapDatabase scene;
-  std::string error;
-  ASSERT_TRUE(WriteSyntheticMapDatabase(options, temp_dir.File("scene.db"),
-                                        &scene, &error))
-      << error;
-  EXPECT_EQ(scene.map.NumRegImages(), 20u);
-  EXPECT_EQ(scene.map.NumPoints3D(), 20u * 200 / 4);
-  ASSERT_EQ(scene.rig_image_names.size(), 4u);
-  EXPECT_EQ(scene.rig_image_names[1], "cam1/010000.png");
+TEST_F(SyntheticMapDatabaseTest, DatabaseMatchesMapAndRigGeometry) {
+  EXPECT_EQ(scene_.map.NumRegImages(), 20u);
+  EXPECT_EQ(scene_.map.NumPoints3D(), 20u * 200 / 4);
+  ASSERT_EQ(scene_.rig_image_names.size(), 4u);
+  EXPECT_EQ(scene_.rig_image_names[1], "cam1/010000.png");
 
   DatabaseReader reader;
-  ASSERT_TRUE(reader.Open(temp_dir.File("scene.db"), &error)) << error;
+  ASSERT_TRUE(reader.Open(temp_dir_.File("scene.db"), &error_)) << error_;
   EXPECT_EQ(reader.Images().size(), 24u);
-  for (const colmap::image_t image_id : scene.map.RegImageIds()) {
-    const colmap::Image& image = scene.map.Image(image_id);
+  for (const colmap::image_t image_id : scene_.map.RegImageIds()) {
+    const colmap::Image& image = scene_.map.Image(image_id);
     const DatabaseImage* database_image =
         reader.FindImageWithName(image.Name());
     ASSERT_NE(database_image, nullptr) << image.Name();
@@ -54,20 +62,20 @@ TEST(SyntheticMapDatabase, DatabaseMatchesMapAndRigGeometry) {
   }
 
   colmap::Camera rig_camera;
-  rig_camera.InitializeWithName("SIMPLE_PINHOLE", options.rig_focal_px,
-                                options.image_width, options.image_height);
-  for (size_t r = 0; r < scene.rig_image_names.size(); ++r) {
+  rig_camera.InitializeWithName("SIMPLE_PINHOLE", options_.rig_focal_px,
+                                options_.image_width, options_.image_height);
+  for (size_t r = 0; r < scene_.rig_image_names.size(); ++r) {
     const DatabaseImage* image =
-        reader.FindImageWithName(scene.rig_image_names[r]);
+        reader.FindImageWithName(scene_.rig_image_names[r]);
     ASSERT_NE(image, nullptr);
     colmap::FeatureKeypoints keypoints;
-    ASSERT_TRUE(reader.ReadKeypoints(image->image_id, &keypoints, &error));
+    ASSERT_TRUE(reader.ReadKeypoints(image->image_id, &keypoints, &error_));
     EXPECT_EQ(keypoints.size(), 300u);
-    EXPECT_GE(scene.rig_planted[r].size(), 120u);
-    EXPECT_LE(scene.rig_planted[r].size(), 150u);
-    for (const auto& [point2D_idx, point3D_id] : scene.rig_planted[r]) {
+    EXPECT_GE(scene_.rig_planted[r].size(), 120u);
+    EXPECT_LE(scene_.rig_planted[r].size(), 150u);
+    for (const auto& [point2D_idx, point3D_id] : scene_.rig_planted[r]) {
       const Eigen::Vector3d point_cam =
-          scene.rig_cam_from_world[r] * scene.map.Point3D(point3D_id).XYZ();
+          scene_.rig_cam_from_world[r] * scene_.map.Point3D(point3D_id).XYZ();
       const Eigen::Vector2d projection =
           rig_camera.WorldToImage(point_cam.hnormalized());
       EXPECT_LT((projection - Eigen::Vector2d(keypoints[point2D_idx].x,
@@ -78,64 +86,58 @@ TEST(SyntheticMapDatabase, DatabaseMatchesMapAndRigGeometry) {
     }
   }
 
-  EXPECT_FALSE(WriteSyntheticMapDatabase(options, temp_dir.File("scene.db"),
-                                         &scene, &error));
-  EXPECT_NE(error.find("exists"), std::string::npos);
-  SyntheticMapDatabaseOptions bad = options;
+  EXPECT_FALSE(WriteSyntheticMapDatabase(options_, temp_dir_.File("scene.db"),
+                                         &scene_, &error_));
+  EXPECT_NE(error_.find("exists"), std::string::npos);
+  SyntheticMapDatabaseOptions bad = options_;
   bad.map_points_per_rig_image = 400;
-  EXPECT_FALSE(
-      WriteSyntheticMapDatabase(bad, temp_dir.File("bad.db"), &scene, &error));
-  EXPECT_NE(error.find("map_points_per_rig_image"), std::string::npos);
+  EXPECT_FALSE(WriteSyntheticMapDatabase(bad, temp_dir_.File("bad.db"), &scene_,
+                                         &error_));
+  EXPECT_NE(error_.find("map_points_per_rig_image"), std::string::npos);
 }
 
 // The localizer finds the planted correspondences, and the radial pose
 // estimated from them is the true one.
-TEST(SyntheticMapDatabase, LocalizerRecoversPlantedCorrespondencesAndPose) {
-  testing::ScopedTempDir temp_dir;
-  const SyntheticMapDatabaseOptions options = SmallOptions();
-  SyntheticMapDatabase scene;
-  std::string error;
-  ASSERT_TRUE(WriteSyntheticMapDatabase(options, temp_dir.File("scene.db"),
-                                        &scene, &error))
-      << error;
+TEST_F(SyntheticMapDatabaseTest,
+       LocalizerRecoversPlantedCorrespondencesAndPose) {
   DatabaseReader reader;
-  ASSERT_TRUE(reader.Open(temp_dir.File("scene.db"), &error)) << error;
+  ASSERT_TRUE(reader.Open(temp_dir_.File("scene.db"), &error_)) << error_;
   MapLocalizerOptions localizer_options;
   localizer_options.num_threads = 1;
   localizer_options.progress_interval = 0;
   const std::unique_ptr<MapLocalizer> localizer =
-      MapLocalizer::Create(localizer_options, scene.map, &reader, &error);
-  ASSERT_NE(localizer, nullptr) << error;
+      MapLocalizer::Create(localizer_options, scene_.map, &reader, &error_);
+  ASSERT_NE(localizer, nullptr) << error_;
   std::vector<ImageLocalization> results;
   ASSERT_TRUE(
-      localizer->LocalizeImages(scene.rig_image_names, &results, &error))
-      << error;
+      localizer->LocalizeImages(scene_.rig_image_names, &results, &error_))
+      << error_;
   ASSERT_EQ(results.size(), 4u);
   for (size_t r = 0; r < results.size(); ++r) {
     int num_correct = 0;
     for (size_t i = 0; i < results[r].correspondences.size(); ++i) {
       const auto planted =
-          scene.rig_planted[r].find(results[r].point2D_idxs[i]);
-      num_correct += planted != scene.rig_planted[r].end() &&
+          scene_.rig_planted[r].find(results[r].point2D_idxs[i]);
+      num_correct += planted != scene_.rig_planted[r].end() &&
                      static_cast<int64_t>(planted->second) ==
                          results[r].correspondences[i].point3D_id;
     }
-    EXPECT_GE(num_correct, 0.9 * scene.rig_planted[r].size()) << r;
+    EXPECT_GE(num_correct, 0.9 * scene_.rig_planted[r].size()) << r;
     EXPECT_GE(num_correct, 0.95 * results[r].correspondences.size()) << r;
 
     std::vector<Eigen::Vector2d> points2D;
     std::vector<Eigen::Vector3d> points3D;
     for (const Correspondence& correspondence : results[r].correspondences) {
       points2D.push_back(correspondence.point2D -
-                         Eigen::Vector2d(0.5 * options.image_width,
-                                         0.5 * options.image_height));
+                         Eigen::Vector2d(0.5 * options_.image_width,
+                                         0.5 * options_.image_height));
       points3D.push_back(correspondence.point3D);
     }
     RadialPoseEstimate estimate;
     ASSERT_TRUE(EstimateRadialPose(RadialPoseEstimationOptions(), points2D,
                                    points3D, &estimate));
     EXPECT_LT(RotationDifferenceDeg(estimate.cam_from_world.rotation,
-                                    scene.rig_cam_from_world[r].rotation),
+                                    scene_.rig_cam_from_world[r].rotation),
               0.5)
         << r;
   }

@@ -9,11 +9,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/map_reader.h"
+#include "src/calibration/calibration_method.h"
 #include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 
@@ -45,6 +48,20 @@ class CommandsTest : public ::testing::Test {
             "TXT"};
   }
 
+  // The per-camera errors of `evaluate` against the ground truth; an empty
+  // array (and a test failure) if it fails.
+  nlohmann::json EvaluatedCameras(const std::string& calibration) {
+    const std::string errors = temp_.File("errors.json");
+    EXPECT_EQ(RunCommand(
+                  &RunEvaluate,
+                  {"--reference_path", data_ + "/ground_truth/camchain.yaml",
+                   "--calibration_path", calibration, "--output_path", errors}),
+              EXIT_SUCCESS);
+    std::ifstream errors_file(errors);
+    if (!errors_file) return nlohmann::json::array();
+    return nlohmann::json::parse(errors_file)["cameras"];
+  }
+
   testing::ScopedTempDir temp_;
   std::string data_;
 };
@@ -63,16 +80,9 @@ TEST_F(CommandsTest, SyntheticCalibrateEvaluate) {
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   EXPECT_EQ(summary["method"], "1dr");
 
-  const std::string errors = temp_.File("errors.json");
-  ASSERT_EQ(
-      RunCommand(&RunEvaluate,
-                 {"--reference_path", data_ + "/ground_truth/camchain.yaml",
-                  "--calibration_path", output, "--output_path", errors}),
-      EXIT_SUCCESS);
-  std::ifstream errors_file(errors);
-  const nlohmann::json error_json = nlohmann::json::parse(errors_file);
-  ASSERT_EQ(error_json["cameras"].size(), 5u);
-  for (const nlohmann::json& camera : error_json["cameras"]) {
+  const nlohmann::json cameras = EvaluatedCameras(output);
+  ASSERT_EQ(cameras.size(), 5u);
+  for (const nlohmann::json& camera : cameras) {
     EXPECT_LT(camera["rotation_deg"].get<double>(), 0.1);
     EXPECT_LT(camera["center_error"].get<double>(), 0.005);
     EXPECT_LT(camera["focal_error_percent"].get<double>(), 0.3);
@@ -117,7 +127,14 @@ TEST_F(CommandsTest, BadInputFailsWithoutOutput) {
   // Unknown method, unknown camera model, unknown option.
   std::vector<std::string> bad_method = arguments;
   bad_method.insert(bad_method.end(), {"--RigCalibrator.method", "magic"});
+  ::testing::internal::CaptureStderr();
   EXPECT_EQ(RunCommand(&RunCalibrate, bad_method), EXIT_FAILURE);
+  const std::string method_messages = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(method_messages.find("--RigCalibrator.method must be one of 1dr, "
+                                 "rd_ra, rd, known, known_refine, known_ra, "
+                                 "not magic"),
+            std::string::npos)
+      << method_messages;
   std::vector<std::string> bad_model = arguments;
   bad_model[5] = "NOT_A_MODEL";
   EXPECT_EQ(RunCommand(&RunCalibrate, bad_model), EXIT_FAILURE);
@@ -134,10 +151,18 @@ TEST_F(CommandsTest, BadInputFailsWithoutOutput) {
   std::vector<std::string> missing_map = arguments;
   missing_map.insert(missing_map.end(), {"--input_path", temp_.File("nomap")});
   EXPECT_EQ(RunCommand(&RunCalibrate, missing_map), EXIT_FAILURE);
-  // known needs intrinsics.
-  std::vector<std::string> known = arguments;
-  known.insert(known.end(), {"--RigCalibrator.method", "known"});
-  EXPECT_EQ(RunCommand(&RunCalibrate, known), EXIT_FAILURE);
+  // The known* methods need intrinsics, and say so.
+  for (const std::string method : {"known", "known_refine", "known_ra"}) {
+    std::vector<std::string> known = arguments;
+    known.insert(known.end(), {"--RigCalibrator.method", method});
+    ::testing::internal::CaptureStderr();
+    EXPECT_EQ(RunCommand(&RunCalibrate, known), EXIT_FAILURE);
+    const std::string messages = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(messages.find("method " + method +
+                            " needs the intrinsics of camera cam0"),
+              std::string::npos)
+        << messages;
+  }
   EXPECT_FALSE(fs::exists(output));
 }
 
@@ -161,6 +186,90 @@ TEST_F(CommandsTest, KnownMethodWithIntrinsicsFile) {
                                      "--RigCalibrator.intrinsics_path",
                                      data_ + "/ground_truth/camchain.yaml"});
   EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+}
+
+// known_ra takes the given intrinsics and the robust rig initialization: it
+// runs, writes the given intrinsics unchanged, and the rig is accurate.
+TEST_F(CommandsTest, KnownRaMethodWithIntrinsicsFile) {
+  const std::string output = temp_.File("known_ra");
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  arguments.insert(arguments.end(), {"--RigCalibrator.method", "known_ra",
+                                     "--RigCalibrator.intrinsics_path",
+                                     data_ + "/ground_truth/camchain.yaml"});
+  ASSERT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+  std::ifstream summary_file(output + "/calibration_summary.json");
+  EXPECT_EQ(nlohmann::json::parse(summary_file)["method"], "known_ra");
+  const nlohmann::json cameras = EvaluatedCameras(output);
+  ASSERT_EQ(cameras.size(), 5u);
+  for (const nlohmann::json& camera : cameras) {
+    EXPECT_LT(camera["rotation_deg"].get<double>(), 0.1);
+    EXPECT_LT(camera["center_error"].get<double>(), 0.005);
+    // Held fixed at the given (true) intrinsics.
+    EXPECT_LT(camera["focal_error_percent"].get<double>(), 1e-6);
+  }
+}
+
+// Without a frameset in which every camera has an image, known (Inf+K) has
+// no rig to start from and says to use known_ra, which then calibrates.
+TEST_F(CommandsTest, KnownWithoutCompleteFramesetNamesKnownRa) {
+  std::vector<ImageCorrespondences> images;
+  std::string error;
+  ASSERT_TRUE(
+      ReadCorrespondenceFile(data_ + "/correspondences.txt", &images, &error))
+      << error;
+  // Drop camera (f mod 5)'s image of frameset f: no frameset is complete.
+  std::map<std::string, int> frameset_of_file;
+  std::vector<ImageCorrespondences> incomplete;
+  for (ImageCorrespondences& image : images) {
+    const size_t slash = image.image_name.find('/');
+    const std::string camera = image.image_name.substr(0, slash);
+    const std::string file = image.image_name.substr(slash + 1);
+    const int frameset =
+        frameset_of_file.emplace(file, frameset_of_file.size()).first->second;
+    if (camera != "cam" + std::to_string(frameset % 5)) {
+      incomplete.push_back(std::move(image));
+    }
+  }
+  ASSERT_EQ(frameset_of_file.size(), 12u);
+  ASSERT_LE(incomplete.size(), 12u * 4);  // the data already misses a few
+  const std::string correspondences = temp_.File("incomplete.txt");
+  ASSERT_TRUE(WriteCorrespondenceFile(correspondences, incomplete, &error))
+      << error;
+
+  for (const std::string method : {"known", "known_ra"}) {
+    const std::string output = temp_.File(method);
+    std::vector<std::string> arguments = CalibrateArguments(output);
+    arguments[1] = correspondences;
+    arguments.insert(arguments.end(), {"--RigCalibrator.method", method,
+                                       "--RigCalibrator.intrinsics_path",
+                                       data_ + "/ground_truth/camchain.yaml"});
+    ::testing::internal::CaptureStderr();
+    const int exit_code = RunCommand(&RunCalibrate, arguments);
+    const std::string messages = ::testing::internal::GetCapturedStderr();
+    if (method == "known") {
+      EXPECT_EQ(exit_code, EXIT_FAILURE);
+      EXPECT_NE(messages.find("use known_ra"), std::string::npos) << messages;
+      EXPECT_FALSE(fs::exists(output));
+    } else {
+      EXPECT_EQ(exit_code, EXIT_SUCCESS) << messages;
+    }
+  }
+}
+
+// The help lists every method of the pipeline under --RigCalibrator.method.
+TEST(Calibrate, HelpListsEveryMethod) {
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(RunCommand(&RunCalibrate, {"--help"}), EXIT_SUCCESS);
+  const std::string help = ::testing::internal::GetCapturedStdout();
+  const size_t option = help.find("--RigCalibrator.method");
+  ASSERT_NE(option, std::string::npos) << help;
+  const std::string text = help.substr(option, 400);
+  for (const std::string method :
+       {"1dr", "rd_ra", "rd", "known", "known_refine", "known_ra"}) {
+    CalibrationMethod value;
+    ASSERT_TRUE(CalibrationMethodFromName(method, &value)) << method;
+    EXPECT_NE(text.find(method), std::string::npos) << method << ": " << text;
+  }
 }
 
 TEST(MapReader, NonColmapFilesAreRejected) {

@@ -3,8 +3,11 @@
 #include <colmap/base/reconstruction.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <boost/filesystem.hpp>
+#include <cmath>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "colmap_ext/io/rig_config_io.h"
@@ -39,58 +42,74 @@ struct SmallDataset {
   }
 };
 
-TEST(RenderCommand, WritesImagesAndExactGroundTruth) {
-  const SmallDataset dataset;
-  testing::ScopedTempDir temp;
-  const std::string out = temp.File("dataset");
-  std::string error;
-  ASSERT_TRUE(WriteRenderedDataset(dataset.options, dataset.plan,
-                                   dataset.render, out, false, &error))
-      << error;
+// The small dataset written into a temporary folder (ctest runs every test
+// in its own process, so a suite-wide setup would not render it less often).
+class RenderCommandOutput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    out_ = temp_.File("dataset");
+    truth_ = out_ + "/ground_truth/";
+    ASSERT_TRUE(WriteRenderedDataset(dataset_->options, dataset_->plan,
+                                     dataset_->render, out_, false, &error_))
+        << error_;
+  }
 
-  // Images: named as planned, of the cameras' sizes, equal to a fresh
-  // rendering with the same noise seed as the writer's (seed << 32 + index).
-  for (const std::string& name : dataset.plan.map_image_names) {
-    EXPECT_TRUE(fs::is_regular_file(out + "/map_images/" + name)) << name;
+  const std::unique_ptr<const SmallDataset> dataset_ =
+      std::make_unique<const SmallDataset>();
+  testing::ScopedTempDir temp_;
+  std::string out_;
+  std::string truth_;
+  std::string error_;
+};
+
+// Images: named as planned, of the cameras' sizes, equal to a fresh
+// rendering with the same noise seed as the writer's (seed << 32 + index).
+TEST_F(RenderCommandOutput, WritesTheRenderedImages) {
+  for (const std::string& name : dataset_->plan.map_image_names) {
+    EXPECT_TRUE(fs::is_regular_file(out_ + "/map_images/" + name)) << name;
   }
   colmap::Bitmap written;
-  ASSERT_TRUE(written.Read(out + "/map_images/map_000001.png", true));
+  ASSERT_TRUE(written.Read(out_ + "/map_images/map_000001.png", true));
   const colmap::Bitmap expected = RenderImage(
-      dataset.plan.scene, dataset.plan.map_camera,
-      dataset.plan.map_cam_from_world[1], dataset.render, (4ull << 32) + 1);
+      dataset_->plan.scene, dataset_->plan.map_camera,
+      dataset_->plan.map_cam_from_world[1], dataset_->render, (4ull << 32) + 1);
   EXPECT_EQ(written.ConvertToRowMajorArray(),
             expected.ConvertToRowMajorArray());
   for (int c = 0; c < 2; ++c) {
     for (int f = 0; f < 2; ++f) {
       colmap::Bitmap image;
       ASSERT_TRUE(image.Read(
-          out + "/rig_images/" + dataset.plan.RigImageName(c, f), true));
-      EXPECT_EQ(image.Width(), dataset.plan.rig.cameras[c].Width());
-      EXPECT_EQ(image.Height(), dataset.plan.rig.cameras[c].Height());
+          out_ + "/rig_images/" + dataset_->plan.RigImageName(c, f), true));
+      EXPECT_EQ(image.Width(), dataset_->plan.rig.cameras[c].Width());
+      EXPECT_EQ(image.Height(), dataset_->plan.rig.cameras[c].Height());
     }
   }
+}
 
-  // Map camera and positions (the format of colmap model_aligner).
-  const std::string truth = out + "/ground_truth/";
-  const std::vector<std::string> camera_lines = Lines(truth + "map_camera.txt");
+// Map camera and positions (the format of colmap model_aligner).
+TEST_F(RenderCommandOutput, WritesTheMapGroundTruth) {
+  const std::vector<std::string> camera_lines =
+      Lines(truth_ + "map_camera.txt");
   ASSERT_EQ(camera_lines.size(), 2u);
   EXPECT_EQ(camera_lines[1], "PINHOLE 640 480 400,400,320,240");
   const std::vector<std::string> positions =
-      Lines(truth + "map_image_positions.txt");
+      Lines(truth_ + "map_image_positions.txt");
   ASSERT_EQ(positions.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     std::istringstream line(positions[i]);
     std::string name;
     Eigen::Vector3d center;
     line >> name >> center.x() >> center.y() >> center.z();
-    EXPECT_EQ(name, dataset.plan.map_image_names[i]);
-    EXPECT_EQ(center, dataset.plan.map_cam_from_world[i].Center());
+    EXPECT_EQ(name, dataset_->plan.map_image_names[i]);
+    EXPECT_EQ(center, dataset_->plan.map_cam_from_world[i].Center());
   }
+}
 
-  // The true rig, read back exactly.
+// The true rig, read back exactly.
+TEST_F(RenderCommandOutput, WritesTheTrueRig) {
   std::vector<RigDescription> rigs;
-  ASSERT_TRUE(ReadRigConfigJson(truth + "rig_config.json", &rigs, &error))
-      << error;
+  ASSERT_TRUE(ReadRigConfigJson(truth_ + "rig_config.json", &rigs, &error_))
+      << error_;
   ASSERT_EQ(rigs.size(), 1u);
   ASSERT_EQ(rigs[0].cameras.size(), 2u);
   EXPECT_EQ(rigs[0].reference_camera, 0);
@@ -99,45 +118,84 @@ TEST(RenderCommand, WritesImagesAndExactGroundTruth) {
     EXPECT_EQ(camera.image_prefix, "cam" + std::to_string(c) + "/");
     ASSERT_TRUE(camera.camera.has_value());
     EXPECT_EQ(camera.camera->ModelName(),
-              dataset.plan.rig.cameras[c].ModelName());
-    EXPECT_EQ(camera.camera->Params(), dataset.plan.rig.cameras[c].Params());
+              dataset_->plan.rig.cameras[c].ModelName());
+    EXPECT_EQ(camera.camera->Params(), dataset_->plan.rig.cameras[c].Params());
   }
   ASSERT_TRUE(rigs[0].cameras[1].cam_from_rig.has_value());
   EXPECT_EQ(rigs[0].cameras[1].cam_from_rig->translation,
-            dataset.plan.rig.cam_from_rig[1].translation);
-  EXPECT_NEAR(RotationDifferenceDeg(rigs[0].cameras[1].cam_from_rig->rotation,
-                                    dataset.plan.rig.cam_from_rig[1].rotation),
-              0, 1e-9);
+            dataset_->plan.rig.cam_from_rig[1].translation);
+  EXPECT_NEAR(
+      RotationDifferenceDeg(rigs[0].cameras[1].cam_from_rig->rotation,
+                            dataset_->plan.rig.cam_from_rig[1].rotation),
+      0, 1e-9);
+}
 
-  // rig_from_world per frameset and the true poses as COLMAP models.
+// rig_from_world per frameset and the true poses as COLMAP models.
+TEST_F(RenderCommandOutput, WritesTheTruePoses) {
+  const RenderedDatasetPlan& plan = dataset_->plan;
+  // A header line, then "<frameset> qw qx qy qz tx ty tz" per frameset, each
+  // number read back bit for bit.
   const std::vector<std::string> rig_poses =
-      Lines(truth + "rig_from_world.txt");
-  ASSERT_EQ(rig_poses.size(), 3u);
-  EXPECT_EQ(rig_poses[2].substr(0, 7), "000001 ");
+      Lines(truth_ + "rig_from_world.txt");
+  ASSERT_EQ(rig_poses.size(), 1 + plan.frameset_names.size());
+  for (size_t f = 0; f < plan.frameset_names.size(); ++f) {
+    std::istringstream line(rig_poses[1 + f]);
+    std::string name;
+    Eigen::Vector4d qvec;
+    Eigen::Vector3d tvec;
+    line >> name >> qvec(0) >> qvec(1) >> qvec(2) >> qvec(3) >> tvec(0) >>
+        tvec(1) >> tvec(2);
+    ASSERT_FALSE(line.fail()) << rig_poses[1 + f];
+    EXPECT_EQ(name, plan.frameset_names[f]);
+    EXPECT_EQ(qvec, plan.rig.rig_from_world[f].Qvec());
+    EXPECT_EQ(tvec, plan.rig.rig_from_world[f].translation);
+  }
+  // Every rig image at cam_from_rig * rig_from_world, with its camera.
   colmap::Reconstruction rig_model;
-  rig_model.ReadText(truth + "rig_model");
+  rig_model.ReadText(truth_ + "rig_model");
   ASSERT_EQ(rig_model.NumRegImages(), 4u);
-  const colmap::Image* image = rig_model.FindImageWithName("cam1/000001.png");
-  ASSERT_NE(image, nullptr);
-  const Rigid3d cam_from_world =
-      dataset.plan.rig.cam_from_rig[1] * dataset.plan.rig.rig_from_world[1];
-  EXPECT_NEAR((image->Tvec() - cam_from_world.translation).norm(), 0, 1e-12);
-  EXPECT_NEAR(rig_model.Camera(image->CameraId()).Params(0),
-              dataset.plan.rig.cameras[1].Params(0), 1e-12);
+  for (int c = 0; c < 2; ++c) {
+    for (int f = 0; f < 2; ++f) {
+      const colmap::Image* image =
+          rig_model.FindImageWithName(plan.RigImageName(c, f));
+      ASSERT_NE(image, nullptr) << plan.RigImageName(c, f);
+      const Rigid3d expected =
+          plan.rig.cam_from_rig[c] * plan.rig.rig_from_world[f];
+      const Rigid3d actual =
+          Rigid3d::FromQvecTvec(image->Qvec(), image->Tvec());
+      EXPECT_LT((actual.ToMatrix() - expected.ToMatrix()).norm(), 1e-12);
+      const colmap::Camera& camera = rig_model.Camera(image->CameraId());
+      EXPECT_EQ(camera.ModelName(), plan.rig.cameras[c].ModelName());
+      for (size_t k = 0; k < camera.NumParams(); ++k) {
+        EXPECT_NEAR(camera.Params(k), plan.rig.cameras[c].Params(k),
+                    1e-12 * std::max(1.0, std::abs(camera.Params(k))));
+      }
+    }
+  }
   colmap::Reconstruction map_model;
-  map_model.ReadText(truth + "map_model");
-  EXPECT_EQ(map_model.NumRegImages(), 3u);
+  map_model.ReadText(truth_ + "map_model");
+  ASSERT_EQ(map_model.NumRegImages(), 3u);
+  for (size_t i = 0; i < plan.map_image_names.size(); ++i) {
+    const colmap::Image* image =
+        map_model.FindImageWithName(plan.map_image_names[i]);
+    ASSERT_NE(image, nullptr) << plan.map_image_names[i];
+    const Rigid3d actual = Rigid3d::FromQvecTvec(image->Qvec(), image->Tvec());
+    EXPECT_LT(
+        (actual.ToMatrix() - plan.map_cam_from_world[i].ToMatrix()).norm(),
+        1e-12);
+  }
 
   bool found_models = false;
-  for (const std::string& line : Lines(truth + "dataset.txt")) {
+  for (const std::string& line : Lines(truth_ + "dataset.txt")) {
     found_models |= line == "camera_models cam0:OPENCV,cam1:OPENCV";
   }
   EXPECT_TRUE(found_models);
+}
 
-  // A second run into the same folder needs overwrite.
-  EXPECT_FALSE(WriteRenderedDataset(dataset.options, dataset.plan,
-                                    dataset.render, out, false, &error));
-  EXPECT_NE(error.find("not empty"), std::string::npos) << error;
+TEST_F(RenderCommandOutput, ASecondRunIntoTheFolderNeedsOverwrite) {
+  EXPECT_FALSE(WriteRenderedDataset(dataset_->options, dataset_->plan,
+                                    dataset_->render, out_, false, &error_));
+  EXPECT_NE(error_.find("not empty"), std::string::npos) << error_;
 }
 
 TEST(RenderCommand, CommandLineErrorsFailCleanly) {

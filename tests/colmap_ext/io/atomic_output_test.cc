@@ -96,6 +96,34 @@ TEST(AtomicOutput, FolderAppearsWhole) {
   EXPECT_NE(error.find("does not exist"), std::string::npos);
 }
 
+// The old output is only replaced once the new one is complete: a failing
+// writer leaves it as it was, even with overwrite. An empty folder in the way
+// needs no overwrite.
+TEST(AtomicOutput, FailedOverwriteKeepsTheOldOutput) {
+  testing::ScopedTempDir dir;
+  const std::string output = dir.File("out");
+  fs::create_directories(output);
+  std::string error;
+  ASSERT_TRUE(WriteFolderAtomically(output, OutputFolderOptions(),
+                                    WriteTwoFiles, &error))
+      << error;
+  std::ofstream(output + "/old.txt") << "old";
+  OutputFolderOptions overwrite;
+  overwrite.overwrite = true;
+  EXPECT_FALSE(WriteFolderAtomically(
+      output, overwrite,
+      [](const std::string& folder, std::string* error) {
+        WriteTwoFiles(folder, error);
+        *error = "disk full";
+        return false;
+      },
+      &error));
+  EXPECT_EQ(testing::ReadBytes(output + "/old.txt"), "old");
+  EXPECT_EQ(testing::ReadBytes(output + "/a.txt"), "a");
+  EXPECT_EQ(NumEntries(output), 3u);
+  EXPECT_EQ(NumEntries(dir.path()), 1u);
+}
+
 TEST(AtomicOutput, OutputMustNotOverlapInputs) {
   testing::ScopedTempDir dir;
   fs::create_directories(dir.File("map/sparse/0"));

@@ -175,6 +175,11 @@ TEST(CamchainIo, RoundTripThroughFile) {
     EXPECT_EQ(read.cameras[i].name, "cam" + std::to_string(i));
     ASSERT_TRUE(read.cameras[i].camera && read.cameras[i].cam_from_rig);
     EXPECT_EQ(read.cameras[i].camera->Width(), original.camera->Width());
+    EXPECT_EQ(read.cameras[i].camera->Height(), original.camera->Height());
+    // Kalibr's pinhole-radtan and pinhole-equidistant come back as OPENCV and
+    // OPENCV_FISHEYE; PINHOLE is written as radtan with zero distortion.
+    const char* const read_models[3] = {"OPENCV_FISHEYE", "OPENCV", "OPENCV"};
+    EXPECT_EQ(read.cameras[i].camera->ModelName(), read_models[i]);
     EXPECT_LT(
         MaxProjectionDifference(*original.camera, *read.cameras[i].camera),
         1e-9);

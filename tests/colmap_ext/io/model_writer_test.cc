@@ -1,3 +1,6 @@
+// The model writer: the model it builds, uncalibrated cameras, timestamp
+// framesets, all-or-nothing output, mismatched calibrations and refined map
+// points.
 #include "colmap_ext/io/model_writer.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +16,7 @@
 #include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/rig_config_io.h"
+#include "tests/colmap_ext/io/model_writer_scene.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -20,196 +24,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kNumMapPoints = 60;
-
-colmap::Camera MakeCamera(const std::string& model,
-                          const std::vector<double>& params) {
-  colmap::Camera camera;
-  camera.SetModelIdFromName(model);
-  camera.SetWidth(640);
-  camera.SetHeight(480);
-  camera.SetParams(params);
-  return camera;
-}
-
-Eigen::Vector2d Project(const colmap::Camera& camera,
-                        const Rigid3d& cam_from_world,
-                        const Eigen::Vector3d& point) {
-  const Eigen::Vector3d x = cam_from_world * point;
-  return camera.WorldToImage(x.hnormalized());
-}
-
-Rigid3d SmallPose(std::mt19937* random, double angle, double offset) {
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  const Eigen::Vector3d axis =
-      Eigen::Vector3d(uniform(*random), uniform(*random), uniform(*random))
-          .normalized();
-  return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),
-                 offset * Eigen::Vector3d(uniform(*random), uniform(*random),
-                                          uniform(*random)));
-}
-
-// A map of one camera, two registered images and points seen by both; a
-// 3-camera rig (reference cam0, whose solved cam_from_rig is deliberately not
-// the identity) over 4 framesets: frameset 3 has no rig pose, the cam2 image
-// of frameset 1 is not used.
-struct Scene {
-  colmap::Reconstruction map;
-  RigDataset dataset;
-  RigCalibration calibration;
-  int num_registered = 0;    // rig images expected in the model
-  int num_observations = 0;  // rig observations expected in the model
-};
-
-Scene MakeScene() {
-  std::mt19937 random(5);
-  Scene scene;
-  colmap::Camera map_camera = MakeCamera("PINHOLE", {500, 500, 320, 240});
-  map_camera.SetCameraId(1);
-  scene.map.AddCamera(map_camera);
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  std::vector<Eigen::Vector3d> points;
-  for (int k = 0; k < kNumMapPoints; ++k) {
-    points.emplace_back(4 * uniform(random), 3 * uniform(random),
-                        10 + 3 * uniform(random));
-  }
-  for (colmap::image_t image_id : {1, 2}) {
-    const Rigid3d pose = SmallPose(&random, 0.05, 0.5);
-    colmap::Image image;
-    image.SetImageId(image_id);
-    image.SetName("map/" + std::to_string(image_id) + ".png");
-    image.SetCameraId(1);
-    image.SetQvec(pose.Qvec());
-    image.SetTvec(pose.translation);
-    std::vector<Eigen::Vector2d> points2D;
-    for (const Eigen::Vector3d& point : points) {
-      points2D.push_back(Project(map_camera, pose, point));
-    }
-    image.SetPoints2D(points2D);
-    scene.map.AddImage(image);
-    scene.map.RegisterImage(image_id);
-  }
-  for (int k = 0; k < kNumMapPoints; ++k) {
-    colmap::Track track;
-    track.AddElement(1, k);
-    track.AddElement(2, k);
-    scene.map.AddPoint3D(points[k], track);
-  }
-
-  RigDataset& dataset = scene.dataset;
-  RigCalibration& calibration = scene.calibration;
-  const std::vector<colmap::Camera> cameras = {
-      MakeCamera("OPENCV_FISHEYE",
-                 {300, 301, 320.5, 240.5, 0.02, -0.003, 1e-4, 0}),
-      MakeCamera("OPENCV", {500, 502, 321, 239, -0.1, 0.01, 1e-4, -1e-4}),
-      MakeCamera("SIMPLE_RADIAL", {450, 320, 240, -0.05})};
-  for (int c = 0; c < 3; ++c) {
-    RigCamera camera;
-    camera.name = "cam" + std::to_string(c);
-    camera.camera = MakeCamera("SIMPLE_RADIAL", {400, 320, 240, 0});
-    dataset.cameras.push_back(camera);
-    calibration.cameras.push_back(cameras[c]);
-    calibration.cam_from_rig.push_back(SmallPose(&random, 0.2, 0.3));
-    calibration.camera_calibrated.push_back(true);
-  }
-  dataset.reference_camera = 0;
-  for (int f = 0; f < 4; ++f) {
-    dataset.frameset_names.push_back(std::to_string(f) + ".png");
-    calibration.rig_from_world.push_back(f == 3 ? std::optional<Rigid3d>()
-                                                : SmallPose(&random, 0.1, 1.0));
-  }
-  for (int f = 0; f < 4; ++f) {
-    for (int c = 0; c < 3; ++c) {
-      RigImage image;
-      image.name = "cam" + std::to_string(c) + "/" + dataset.frameset_names[f];
-      image.camera_index = c;
-      image.frameset_index = f;
-      ImageResult result;
-      result.localized = true;
-      result.used = f != 3 && !(f == 1 && c == 2);
-      const Rigid3d cam_from_world =
-          f == 3 ? Rigid3d() : calibration.CamFromWorld(c, f);
-      for (int k = 0; k < 20; ++k) {
-        const int point = (7 * f + 3 * c + k) % kNumMapPoints;
-        Correspondence correspondence;
-        correspondence.point3D = points[point];
-        correspondence.point2D =
-            Project(cameras[c], cam_from_world, points[point]);
-        correspondence.point3D_id = point + 1;
-        image.correspondences.push_back(correspondence);
-        result.inlier_mask.push_back(k % 5 != 0);
-      }
-      // Not a map point id, and a second observation of a point: neither is
-      // added to the model.
-      Correspondence unknown = image.correspondences[1];
-      unknown.point3D_id = 9999;
-      image.correspondences.push_back(unknown);
-      result.inlier_mask.push_back(true);
-      image.correspondences.push_back(image.correspondences[2]);
-      result.inlier_mask.push_back(true);
-      result.num_inliers = 16;
-      result.rms_px = 0.5 + c;
-      result.radial_rms_px = 0.25;
-      if (result.used) {
-        ++scene.num_registered;
-        scene.num_observations += 16;
-      }
-      dataset.images.push_back(image);
-      calibration.images.push_back(result);
-    }
-  }
-  return scene;
-}
-
-size_t NumObservations(const colmap::Reconstruction& model) {
-  size_t count = 0;
-  for (const auto& [image_id, image] : model.Images()) {
-    count += image.NumPoints3D();
-  }
-  return count;
-}
-
-// Every registered image of `model` is in exactly one frame, and its pose is
-// sensor_from_rig * rig_from_world of that frame.
-void ExpectFramesMatchImages(const colmap::Reconstruction& model,
-                             const ColmapRigsAndFrames& rigs_frames) {
-  std::map<uint32_t, const ColmapRig*> rigs;
-  for (const ColmapRig& rig : rigs_frames.rigs) {
-    EXPECT_TRUE(rigs.emplace(rig.rig_id, &rig).second) << "duplicate rig id";
-  }
-  std::set<uint32_t> frame_ids;
-  std::map<uint64_t, int> image_frames;
-  for (const ColmapFrame& frame : rigs_frames.frames) {
-    EXPECT_TRUE(frame_ids.insert(frame.frame_id).second) << "duplicate frame";
-    ASSERT_EQ(rigs.count(frame.rig_id), 1u);
-    const ColmapRig& rig = *rigs[frame.rig_id];
-    for (const ColmapFrameData& data : frame.data) {
-      ++image_frames[data.data_id];
-      EXPECT_EQ(data.sensor.type, kSensorCamera);
-      std::optional<Rigid3d> sensor_from_rig;
-      if (data.sensor.id == rig.ref_sensor.id) {
-        sensor_from_rig = Rigid3d();
-      }
-      for (const ColmapRigSensor& sensor : rig.sensors) {
-        if (sensor.sensor.id == data.sensor.id) {
-          sensor_from_rig = sensor.sensor_from_rig;
-        }
-      }
-      ASSERT_TRUE(sensor_from_rig)
-          << "camera " << data.sensor.id << " is not a posed sensor of its rig";
-      const colmap::Image& image = model.Image(data.data_id);
-      EXPECT_EQ(image.CameraId(), data.sensor.id);
-      const Rigid3d expected = *sensor_from_rig * frame.rig_from_world;
-      const Rigid3d actual = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
-      EXPECT_LT((expected.ToMatrix() - actual.ToMatrix()).norm(), 1e-9)
-          << image.Name();
-    }
-  }
-  for (const colmap::image_t image_id : model.RegImageIds()) {
-    EXPECT_EQ(image_frames[image_id], 1) << model.Image(image_id).Name();
-  }
-  EXPECT_EQ(image_frames.size(), model.NumRegImages());
-}
+using testing::ExpectFramesMatchImages;
+using testing::kNumMapPoints;
+using testing::MakeCamera;
+using testing::MakeScene;
+using testing::NumObservations;
+using testing::Project;
+using testing::Scene;
+using testing::SmallPose;
 
 TEST(ModelWriter, BuildsTheModel) {
   const Scene scene = MakeScene();
@@ -259,145 +81,6 @@ TEST(ModelWriter, BuildsTheModel) {
       (rig_model.rig.cam_from_rig[0]->ToMatrix() - Rigid3d().ToMatrix()).norm(),
       1e-15);
 }
-
-class ModelWriterOutput : public ::testing::TestWithParam<std::string> {};
-
-TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
-  const std::string output_type = GetParam();
-  const bool binary = output_type == "BIN";
-  const Scene scene = MakeScene();
-  testing::ScopedTempDir dir;
-  const std::string output = dir.File("out");
-  CalibrationSummary summary =
-      SummarizeCalibration(scene.dataset, scene.calibration, {});
-  summary.method = "1dr";
-  summary.diagnostics.push_back("a diagnostic of the caller");
-  summary.timings_s.emplace_back("localize", 1.5);
-  RigOutputOptions options;
-  options.output_type = output_type;
-  std::vector<std::string> notes;
-  std::string error;
-  ASSERT_TRUE(WriteRigOutput(output, scene.map, scene.dataset,
-                             scene.calibration, {}, summary, options, &notes,
-                             &error))
-      << error;
-
-  const std::string extension = binary ? ".bin" : ".txt";
-  std::set<std::string> files;
-  for (const auto& entry : fs::directory_iterator(output)) {
-    files.insert(entry.path().filename().string());
-  }
-  EXPECT_EQ(files,
-            (std::set<std::string>{"cameras" + extension, "images" + extension,
-                                   "points3D" + extension, "rigs" + extension,
-                                   "frames" + extension, kRigConfigFile,
-                                   kRigBundleAdjusterConfigFile, kCamchainFile,
-                                   kSummaryFile, kCorrespondencesFile}));
-  // No temporary folder is left next to the output.
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()),
-                          fs::directory_iterator()),
-            1);
-
-  colmap::Reconstruction model;
-  model.Read(output);
-  EXPECT_EQ(model.NumCameras(), 4u);
-  EXPECT_EQ(model.NumImages(), 2u + scene.num_registered);
-  EXPECT_EQ(model.NumRegImages(), 2u + scene.num_registered);
-  EXPECT_EQ(model.NumPoints3D(), static_cast<size_t>(kNumMapPoints));
-  EXPECT_EQ(NumObservations(model),
-            2u * kNumMapPoints + scene.num_observations);
-  EXPECT_EQ(model.Camera(3).ModelName(), "OPENCV");
-  EXPECT_EQ(model.Camera(3).Params(), scene.calibration.cameras[1].Params());
-
-  ColmapRigsAndFrames rigs_frames;
-  ASSERT_TRUE(ReadRigsAndFrames(output, &rigs_frames, &error)) << error;
-  ASSERT_EQ(rigs_frames.rigs.size(), 2u);
-  EXPECT_EQ(rigs_frames.rigs[0].rig_id, 1u);
-  EXPECT_EQ(rigs_frames.rigs[1].rig_id, 5u);
-  EXPECT_EQ(rigs_frames.rigs[1].ref_sensor.id, 2u);
-  ASSERT_EQ(rigs_frames.rigs[1].sensors.size(), 2u);
-  // Two trivial map frames (ids = image ids) and three rig frames, with ids
-  // after every image id (the largest is 11).
-  ASSERT_EQ(rigs_frames.frames.size(), 5u);
-  EXPECT_EQ(rigs_frames.frames[0].frame_id, 1u);
-  EXPECT_EQ(rigs_frames.frames[1].frame_id, 2u);
-  for (int f = 2; f < 5; ++f) {
-    EXPECT_EQ(rigs_frames.frames[f].frame_id, 12u + (f - 2));
-  }
-  ExpectFramesMatchImages(model, rigs_frames);
-
-  if (!binary) {
-    // The exact text of COLMAP >= 3.12: trivial rig and frame lines, single
-    // spaces, no trailing space.
-    const std::string rigs = testing::ReadBytes(output + "/rigs.txt");
-    EXPECT_NE(rigs.find("# Number of rigs: 2\n1 1 CAMERA 1\n5 3 CAMERA 2 "
-                        "CAMERA 3 1 "),
-              std::string::npos)
-        << rigs;
-    const std::string frames = testing::ReadBytes(output + "/frames.txt");
-    std::istringstream lines(frames);
-    std::string line;
-    int num_data_lines = 0;
-    while (std::getline(lines, line)) {
-      if (line[0] == '#') continue;
-      ++num_data_lines;
-      EXPECT_EQ(line.find("  "), std::string::npos) << line;
-      EXPECT_NE(line.back(), ' ') << line;
-    }
-    EXPECT_EQ(num_data_lines, 5);
-    EXPECT_NE(frames.find("\n1 1 "), std::string::npos);
-    EXPECT_NE(frames.find(" 1 CAMERA 1 1\n"), std::string::npos);
-    EXPECT_NE(frames.find(" 2 CAMERA 2 6 CAMERA 3 7\n"), std::string::npos)
-        << frames;  // frameset 1 without its unused cam2 image (id 8)
-  }
-
-  // The exchange formats describe the same rig.
-  std::vector<RigDescription> rig_config;
-  ASSERT_TRUE(
-      ReadRigConfigJson(output + "/" + kRigConfigFile, &rig_config, &error))
-      << error;
-  RigDescription camchain;
-  ASSERT_TRUE(ReadCamchainYaml(output + "/" + kCamchainFile, &camchain, &error))
-      << error;
-  ASSERT_EQ(rig_config.size(), 1u);
-  ASSERT_EQ(camchain.cameras.size(), 3u);
-  const ColmapRig& rig = rigs_frames.rigs[1];
-  for (int c = 1; c < 3; ++c) {
-    const Rigid3d& sensor_from_rig = *rig.sensors[c - 1].sensor_from_rig;
-    EXPECT_LT((rig_config[0].cameras[c].cam_from_rig->ToMatrix() -
-               sensor_from_rig.ToMatrix())
-                  .norm(),
-              1e-12);
-    EXPECT_LT((camchain.cameras[c].cam_from_rig->ToMatrix() -
-               sensor_from_rig.ToMatrix())
-                  .norm(),
-              1e-12);
-  }
-
-  std::ifstream summary_file(output + "/" + kSummaryFile);
-  const nlohmann::json json = nlohmann::json::parse(summary_file);
-  EXPECT_EQ(json["method"], "1dr");
-  EXPECT_EQ(json["num_framesets"], 4);
-  EXPECT_EQ(json["num_framesets_used"], 3);
-  ASSERT_EQ(json["cameras"].size(), 3u);
-  EXPECT_EQ(json["cameras"][2]["num_images"], 4);
-  EXPECT_EQ(json["cameras"][2]["num_used"], 2);
-  EXPECT_EQ(json["cameras"][2]["num_inliers"], 32);
-  EXPECT_DOUBLE_EQ(json["cameras"][2]["rms_px"].get<double>(), 2.5);
-  EXPECT_EQ(json["cameras"][1]["model"], "OPENCV");
-  EXPECT_EQ(json["cameras"][0]["cam_from_rig"]["rotation_wxyz"][0], 1.0);
-  EXPECT_EQ(json["diagnostics"][0], "a diagnostic of the caller");
-  EXPECT_EQ(json["timings_s"]["localize"], 1.5);
-
-  std::vector<ImageCorrespondences> correspondences;
-  ASSERT_TRUE(ReadCorrespondenceFile(output + "/" + kCorrespondencesFile,
-                                     &correspondences, &error))
-      << error;
-  EXPECT_EQ(correspondences.size(), scene.dataset.images.size());
-}
-
-INSTANTIATE_TEST_SUITE_P(BinAndTxt, ModelWriterOutput,
-                         ::testing::Values("BIN", "TXT"));
 
 TEST(ModelWriter, UncalibratedCameraHasNoPoseAndNoImages) {
   Scene scene = MakeScene();
