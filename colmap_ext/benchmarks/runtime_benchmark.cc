@@ -374,9 +374,10 @@ std::string LocalizationRuntimeMarkdown(
        << (run.mode == "direct" ? std::to_string(run.num_checks) : "-") << " | "
        << run.num_images << " | " << Fixed(run.index_seconds, 2) << " ("
        << Fixed(run.index_cpu_seconds, 2) << ") | "
-       << Fixed(run.ImagesPerSecond(), 2) << " | " << Fixed(run.CpuSecondsPerImage(), 3)
-       << " | " << Fixed(run.recall, 3) << " | " << Fixed(run.precision, 3)
-       << " | " << Fixed(1000 * run.radial_pose_seconds_per_image, 2) << " | "
+       << Fixed(run.ImagesPerSecond(), 2) << " | "
+       << Fixed(run.CpuSecondsPerImage(), 3) << " | " << Fixed(run.recall, 3)
+       << " | " << Fixed(run.precision, 3) << " | "
+       << Fixed(1000 * run.radial_pose_seconds_per_image, 2) << " | "
        << run.num_poses_correct << "/" << run.num_images << " | "
        << Fixed(run.peak_memory_mb, 0) << " |\n";
   }

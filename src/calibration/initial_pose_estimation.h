@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "src/calibration/camera_upgrader.h"
-#include "src/estimators/radial_pose_estimator.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/estimators/radial_pose_estimator.h"
 
 namespace rig_calibrator {
 

@@ -8,11 +8,10 @@ namespace rig_calibrator {
 namespace {
 
 TEST(NumberText, DoublesRoundTripBitForBit) {
-  for (const double value :
-       {312.41, 1e-5, -0.5, 0.1 + 0.2, 6.02214076e23,
-        std::numeric_limits<double>::denorm_min(),
-        std::numeric_limits<double>::max(),
-        std::numeric_limits<double>::lowest(), 1.0 / 3}) {
+  for (const double value : {312.41, 1e-5, -0.5, 0.1 + 0.2, 6.02214076e23,
+                             std::numeric_limits<double>::denorm_min(),
+                             std::numeric_limits<double>::max(),
+                             std::numeric_limits<double>::lowest(), 1.0 / 3}) {
     double parsed = 0;
     ASSERT_TRUE(ParseDouble(FormatDouble(value), &parsed)) << value;
     EXPECT_EQ(parsed, value);
