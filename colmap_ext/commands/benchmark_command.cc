@@ -6,6 +6,7 @@
 //    Table 1), the robustness tables (§5.3, Table 3) and the distributions
 //    of the initial errors (§5.4, Fig. 6) as Markdown, CSV and SVG files in
 //    the folder --output_path (created if needed; files are replaced).
+#include <colmap/util/misc.h>
 #include <glog/logging.h>
 
 #include <boost/filesystem.hpp>
@@ -100,8 +101,8 @@ bool RunAccuracy(const AccuracyOptions& options, const std::string& folder) {
            << 100 * options.recording.missing_image_ratio
            << " % missing images. Errors against the true calibration; "
               "the rig is aligned on all cameras' orientations, without "
-              "scale. known and known_refine are given the true "
-              "intrinsics.\n\n## Mean over the cameras\n\n"
+              "scale. The methods with given intrinsics (known*) are given "
+              "the true intrinsics.\n\n## Mean over the cameras\n\n"
            << paper_table << "\n## Mean / max over the cameras\n\n"
            << table;
   return WriteResult(folder, "accuracy.md", markdown.str()) &&
@@ -197,8 +198,29 @@ struct BenchmarkCommandOptions {
   int framesets_per_sequence = 10;
   int recording_framesets = 120;
   int accuracy_framesets = 60;
+  // Comma-separated method names; empty: the paper's methods of each table
+  // (paper_methods.h).
+  std::string methods;
   DataOverrides overrides;
 };
+
+// --methods into `methods`; left unchanged (the table's default) if empty.
+bool ParseMethods(const std::string& names,
+                  std::vector<CalibrationMethod>* methods) {
+  if (names.empty()) return true;
+  methods->clear();
+  for (const std::string& name : colmap::CSVToVector<std::string>(names)) {
+    CalibrationMethod method;
+    if (!CalibrationMethodFromName(name, &method)) {
+      PrintError("unknown method " + name +
+                 " in --methods (known, "
+                 "known_refine, known_ra, rd, rd_ra, 1dr)");
+      return false;
+    }
+    methods->push_back(method);
+  }
+  return !methods->empty();
+}
 
 boost::program_options::options_description Describe(
     BenchmarkCommandOptions* o) {
@@ -228,6 +250,10 @@ boost::program_options::options_description Describe(
             "framesets of the recording the sequences are cut from");
   AddOption(&description, "accuracy_framesets", &o->accuracy_framesets,
             "framesets of each accuracy recording");
+  AddUnsetOption(&description, "methods", &o->methods,
+                 "comma-separated methods, e.g. known,known_refine,known_ra "
+                 "(default: the paper's; Table 1: known, known_refine, rd, "
+                 "rd_ra, 1dr; Table 3 and short_sequence: rd, rd_ra, 1dr)");
   o->overrides.AddOptions(&description);
   AddOption(&description, "num_threads", &o->num_threads,
             "calibrations run in parallel (-1: all cores)");
@@ -246,6 +272,7 @@ int RunShortSequence(const BenchmarkCommandOptions& command) {
                       ", " + command.scene_name + ", " +
                       command.difficulty_name);
   }
+  if (!ParseMethods(command.methods, &options.methods)) return EXIT_FAILURE;
   command.overrides.Apply(&difficulty);
   ApplyScene(scene, &options.recording);
   ApplyDifficulty(difficulty, &options);
@@ -301,6 +328,7 @@ int RunExperiments(const BenchmarkCommandOptions& command) {
     AccuracyOptions options;
     options.num_framesets = command.quick ? 15 : command.accuracy_framesets;
     if (command.quick) options.scenes.resize(1);
+    if (!ParseMethods(command.methods, &options.methods)) return EXIT_FAILURE;
     options.seed = static_cast<unsigned int>(command.seed);
     options.num_threads = command.num_threads;
     if (!RunAccuracy(options, command.output_path)) return EXIT_FAILURE;
@@ -311,6 +339,7 @@ int RunExperiments(const BenchmarkCommandOptions& command) {
     options.framesets_per_sequence = command.framesets_per_sequence;
     options.recording_framesets =
         command.quick ? 40 : command.recording_framesets;
+    if (!ParseMethods(command.methods, &options.methods)) return EXIT_FAILURE;
     options.seed = static_cast<unsigned int>(command.seed);
     options.num_threads = command.num_threads;
     if (!RunRobustness(options, command.output_path)) return EXIT_FAILURE;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <string>
 
 #include "src/calibration/pipeline.h"
@@ -90,6 +91,11 @@ TEST(FrontBackRig, DefaultMethodFallsBackToRdRaAndCalibrates) {
   ASSERT_TRUE(error.ok()) << error.error;
   EXPECT_TRUE(calibration.camera_calibrated[0]);
   EXPECT_TRUE(calibration.camera_calibrated[1]);
+  // The figures the README quotes.
+  std::cout << "front/back rig via rd_ra: rotation " << error.MaxRotationDeg()
+            << " deg, center " << 1000 * error.MaxCenterError() << " mm, focal "
+            << error.MaxFocalErrorPercent() << " %, principal point "
+            << error.MaxPrincipalPointErrorPx() << " px" << std::endl;
   EXPECT_LT(error.MaxRotationDeg(), 0.1);
   EXPECT_LT(error.MaxCenterError(), 0.005);
   EXPECT_LT(error.MaxFocalErrorPercent(), 0.5);
