@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds a COLMAP sparse map from a folder of images with the colmap CLI (CPU):
+# Builds a COLMAP sparse map from a folder of images with the colmap CLI (CPU;
+# the build's colmap, COLMAP 3.8's commands, unless COLMAP says otherwise):
 # feature_extractor, sequential (or exhaustive) matching, mapper, and, given
 # reference camera positions, model_aligner, so the map is metric and in the
 # reference frame.
@@ -14,8 +15,8 @@
 #                  intrinsics (held fixed); otherwise one SIMPLE_RADIAL camera
 #                  is estimated
 # Environment:
-#   COLMAP                 colmap 3.8 binary (default: the one built by
-#                          scripts/setup_deps.sh, else `colmap` on PATH)
+#   COLMAP                 colmap 3.8 binary (default: build/colmap, the
+#                          build's extended colmap)
 #   MAP_MATCHER            sequential (default) or exhaustive
 #   MAP_OVERLAP            sequential matching overlap (default 8)
 #   MAP_MAX_FEATURES       SIFT features per image (default 4096)
@@ -70,6 +71,7 @@ database="$work_dir/database.db"
 [[ ! -e "$work_dir/sparse" ]] || die "$work_dir/sparse exists; use a fresh WORK_DIR"
 log="$work_dir/build_map.log"
 : > "$log"
+echo "[build_map] colmap: $colmap"
 
 # Runs one colmap step, its output in the log, and prints its time.
 step() {

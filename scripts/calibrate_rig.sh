@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Calibrates a rig against a COLMAP map: copies the map's database (the input
 # is never modified), extracts SIFT features of the rig images into the copy
-# (one COLMAP camera per camera folder), then runs rig_calibrator.
+# (one COLMAP camera per camera folder), then runs `colmap rig_calibrator`
+# with the build's extended colmap.
 #
 # Usage: scripts/calibrate_rig.sh MAP_DB MAP_MODEL RIG_IMAGES OUT [rig_calibrator options...]
 #   MAP_DB      the map's COLMAP 3.8 database (with its images' features)
@@ -11,12 +12,12 @@
 #   OUT         created (must not exist or be empty); gets database.db (map +
 #               rig features) and calibration/ (rig_calibrator's output:
 #               model, rig_config.json, rigs/frames, camchain.yaml, summary)
-#   options     passed to rig_calibrator, e.g. --RigCalibrator.method 1dr
+#   options     passed to `colmap rig_calibrator`, e.g. --RigCalibrator.method 1dr
 #               --RigCalibrator.camera_model OPENCV
 # Environment:
-#   COLMAP            colmap 3.8 binary (default: the one built by
-#                     scripts/setup_deps.sh, else `colmap` on PATH)
-#   RIG_CALIBRATOR    rig_calibrator binary (default: build/rig_calibrator)
+#   COLMAP            colmap 3.8 binary of the feature extraction (default:
+#                     build/colmap, the build's extended colmap, which also
+#                     calibrates)
 #   RIG_MAX_FEATURES  SIFT features per rig image (default 4096)
 #   RIG_NUM_THREADS   feature extraction threads (default: all cores)
 set -euo pipefail
@@ -34,8 +35,6 @@ shift 4
 
 # shellcheck source=find_colmap.sh
 source "$repo/scripts/find_colmap.sh"
-rig_calibrator="${RIG_CALIBRATOR:-$rig_calibrator}"
-[[ -x "$rig_calibrator" ]] || die "no rig_calibrator at $rig_calibrator: build it (scripts/build.sh) or set RIG_CALIBRATOR"
 max_features="${RIG_MAX_FEATURES:-4096}"
 threads="${RIG_NUM_THREADS:--1}"
 
@@ -55,6 +54,7 @@ log="$out/calibrate_rig.log"
 start=$SECONDS
 cp "$map_db" "$database"
 echo "[calibrate_rig] copied the map database to $database"
+echo "[calibrate_rig] colmap: $colmap; calibration: $colmap_extended rig_calibrator"
 echo "[calibrate_rig] feature extraction of the rig images ($num_cameras cameras) ..."
 if ! "$colmap" feature_extractor --database_path "$database" \
     --image_path "$rig_images" --ImageReader.single_camera_per_folder 1 \
@@ -68,9 +68,9 @@ echo "[calibrate_rig] feature extraction: $((SECONDS - start)) s"
 start=$SECONDS
 echo "[calibrate_rig] rig_calibrator ..."
 status=0
-"$rig_calibrator" --database_path "$database" --image_path "$rig_images" \
+"$colmap_extended" rig_calibrator --database_path "$database" --image_path "$rig_images" \
   --input_path "$map_model" --output_path "$out/calibration" "$@" 2>&1 |
   tee -a "$log" || status=${PIPESTATUS[0]}
-[[ "$status" -eq 0 ]] || die "rig_calibrator failed with status $status (log: $log)"
+[[ "$status" -eq 0 ]] || die "colmap rig_calibrator failed with status $status (log: $log)"
 echo "[calibrate_rig] rig_calibrator: $((SECONDS - start)) s"
 echo "[calibrate_rig] done: calibration in $out/calibration"

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The end-to-end demo on rendered images with exact ground truth:
-#   1. builds rig_calibrator (scripts/build.sh),
+#   1. builds rig_calibrator and the extended colmap (scripts/build.sh),
 #   2. renders a scene seen by a calibrated pinhole camera (the mapping
 #      sequence) and by a rig (the calibration sequence),
-#   3. builds a metric COLMAP map from the mapping sequence (colmap CLI,
-#      aligned to the true camera positions),
-#   4. calibrates the rig against the map (colmap features + rig_calibrator),
+#   3. builds a metric COLMAP map from the mapping sequence (the build's
+#      colmap, COLMAP 3.8's commands; aligned to the true camera positions),
+#   4. calibrates the rig against the map (colmap feature_extractor, then
+#      colmap rig_calibrator),
 #   5. compares the calibration with the true rig.
 # Prints the time of every step and where the outputs are.
 #
@@ -49,10 +50,11 @@ demo_start=$SECONDS
 if [[ "${DEMO_SKIP_BUILD:-0}" != 1 ]]; then
   run_step "build" bash "$repo/scripts/build.sh"
 fi
-[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh)"
+# shellcheck source=find_colmap.sh
+source "$repo/scripts/find_colmap.sh"
 
 dataset="$out/dataset"
-run_step "render ($preset, $scene)" "$rig_calibrator" render \
+run_step "render ($preset, $scene)" "$colmap_extended" rig_calibrator render \
   --preset "$preset" --scene "$scene" --seed "$seed" \
   --num_map_images "$num_map_images" --num_framesets "$num_framesets" \
   --output_path "$dataset"
@@ -69,11 +71,11 @@ run_step "map (colmap)" env MAP_MAX_FEATURES="${MAP_MAX_FEATURES:-2048}" \
   "$dataset/map_images" "$out/map" "$truth/map_image_positions.txt" "$map_params"
 
 # The camera model of every camera is the true one's (the lens type is known).
-run_step "calibration (colmap + rig_calibrator)" env RIG_CALIBRATOR="$rig_calibrator" \
+run_step "calibration (colmap + rig_calibrator)" \
   bash "$repo/scripts/calibrate_rig.sh" "$out/map/database.db" "$out/map/sparse/0" \
   "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_models"
 
-run_step "evaluation" "$rig_calibrator" evaluate \
+run_step "evaluation" "$colmap_extended" rig_calibrator evaluate \
   --reference_path "$truth/rig_config.json" \
   --calibration_path "$out/rig/calibration"
 

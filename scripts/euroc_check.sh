@@ -69,9 +69,6 @@ mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 touch "$out/$marker"
 
-# shellcheck source=find_colmap.sh
-source "$repo/scripts/find_colmap.sh"
-
 total_start=$SECONDS
 step_name_width=52
 # Runs one colmap command, its output appended to $log.
@@ -89,6 +86,8 @@ if [[ "${EUROC_SKIP_BUILD:-0}" != 1 ]]; then
   run_step "build" bash "$repo/scripts/build.sh"
 fi
 [[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh)"
+# shellcheck source=find_colmap.sh
+source "$repo/scripts/find_colmap.sh"
 
 # --- 1. Reference --------------------------------------------------------------
 reference="$out/reference/camchain.yaml"
@@ -182,7 +181,7 @@ run_step "map (colmap, stereo framesets)" build_map
 
 # --- 4. Calibration -----------------------------------------------------------------
 run_step "calibration (colmap features + rig_calibrator)" \
-  env RIG_CALIBRATOR="$rig_calibrator" bash "$repo/scripts/calibrate_rig.sh" \
+  bash "$repo/scripts/calibrate_rig.sh" \
   "$map/database.db" "$map/sparse/0" "$out/rig_images" "$out/rig" \
   --RigCalibrator.camera_model OPENCV
 

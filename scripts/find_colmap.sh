@@ -1,14 +1,13 @@
-# Sourced by the pipeline scripts: sets `colmap` to the colmap 3.8 binary, in
-# this order: $COLMAP, the one scripts/setup_deps.sh built into the cache,
-# `colmap` on PATH. Needs a `die` function.
-default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
-if [[ -n "${COLMAP:-}" ]]; then
-  colmap="$COLMAP"
-elif [[ -x "$default_colmap" ]]; then
-  colmap="$default_colmap"
-elif command -v colmap > /dev/null; then
-  colmap="$(command -v colmap)"
-else
-  die "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
-fi
+# Sourced by the pipeline scripts (after common.sh): sets
+#   colmap_extended  the build's colmap: COLMAP 3.8's command line plus
+#                    `colmap rig_calibrator` (README, "The extended colmap
+#                    command"); the scripts calibrate with it;
+#   colmap           the colmap of the COLMAP steps (feature_extractor,
+#                    mapper, ...): $COLMAP if set (another COLMAP 3.8 CLI),
+#                    else the build's.
+# Needs a `die` function.
+colmap_extended="$build/colmap"
+[[ -x "$colmap_extended" ]] ||
+  die "no $colmap_extended: build it (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+colmap="${COLMAP:-$colmap_extended}"
 [[ -x "$colmap" ]] || die "COLMAP=$colmap is not executable"

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs everything rig_calibrator needs on Debian 12 (bookworm) and builds COLMAP 3.8's
 # libraries, headers and command-line tool from Debian's source package into a cache prefix
-# outside the repository. Idempotent: a rerun with the cache in place skips the COLMAP build.
+# outside the repository, keeping the unpacked source beside it ($cache/src/colmap-3.8: the
+# project's extended `colmap` compiles COLMAP's command sources from it). Idempotent: a rerun
+# with the cache in place skips the COLMAP build, and unpacks the source again if it is gone.
 #
 # Environment:
 #   RIG_CALIBRATOR_CACHE  cache folder (default: $HOME/.cache/rig_calibrator)
@@ -62,27 +64,35 @@ for tool in g++ cmake make; do
   command -v "$tool" >/dev/null 2>&1 || die "'$tool' not found after installing packages."
 done
 
-if [ -f "$stamp" ] && [ -x "$prefix/bin/colmap" ] && [ -f "$prefix/share/colmap/COLMAPConfig.cmake" ]; then
-  say "COLMAP 3.8 found in cache $prefix: skipping its build"
-  exit 0
-fi
-
-say "building COLMAP 3.8 from Debian's source package into $prefix (about 12 minutes on 2 cores)"
+# COLMAP's source tree stays in the cache after the build: the project's
+# `colmap` executable compiles COLMAP's own command sources (src/exe) from it.
 src_root="$cache/src"
-mkdir -p "$src_root" "$cache/apt/lists/partial"
-cat > "$cache/apt/sources.list" <<SRC
+src="$src_root/colmap-3.8"
+fetch_colmap_source() {
+  [ -f "$src/src/exe/colmap.cc" ] && return 0
+  say "unpacking COLMAP 3.8's source (Debian's source package) into $src_root"
+  mkdir -p "$src_root" "$cache/apt/lists/partial"
+  cat > "$cache/apt/sources.list" <<SRC
 deb-src http://deb.debian.org/debian bookworm main
 SRC
-apt_opts=(-o "Dir::Etc::SourceList=$cache/apt/sources.list" -o "Dir::Etc::SourceParts=/dev/null"
-          -o "Dir::State::Lists=$cache/apt/lists")
-if ! ls "$src_root"/colmap-3.8/CMakeLists.txt >/dev/null 2>&1; then
+  local apt_opts=(-o "Dir::Etc::SourceList=$cache/apt/sources.list" -o "Dir::Etc::SourceParts=/dev/null"
+                  -o "Dir::State::Lists=$cache/apt/lists")
   apt-get "${apt_opts[@]}" update -qq > "$cache/apt-source.log" 2>&1 \
     || { tail -n 20 "$cache/apt-source.log"; die "could not read the bookworm deb-src index."; }
   (cd "$src_root" && apt-get "${apt_opts[@]}" source -qq colmap=3.8-1) >> "$cache/apt-source.log" 2>&1 \
     || { tail -n 20 "$cache/apt-source.log"; die "apt-get source colmap=3.8-1 failed."; }
+  [ -f "$src/CMakeLists.txt" ] && [ -f "$src/src/exe/colmap.cc" ] \
+    || die "COLMAP source not found in $src."
+}
+
+if [ -f "$stamp" ] && [ -x "$prefix/bin/colmap" ] && [ -f "$prefix/share/colmap/COLMAPConfig.cmake" ]; then
+  fetch_colmap_source
+  say "COLMAP 3.8 found in cache $prefix (source in $src): skipping its build"
+  exit 0
 fi
-src="$src_root/colmap-3.8"
-[ -f "$src/CMakeLists.txt" ] || die "COLMAP source not found in $src."
+
+say "building COLMAP 3.8 from Debian's source package into $prefix (about 12 minutes on 2 cores)"
+fetch_colmap_source
 
 build="$src/build-rig-calibrator"
 mkdir -p "$build"

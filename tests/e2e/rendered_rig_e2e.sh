@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # End-to-end test on rendered images (ctest: rendered_rig_e2e, label e2e):
-#   1. renders a small ring5 dataset in the room, builds a metric map with the
-#      colmap CLI and calibrates the rig against it (scripts/demo.sh:
-#      build_map.sh, then calibrate_rig.sh with the database);
+#   1. renders a small ring5 dataset in the room, builds a metric map and
+#      calibrates the rig against it (scripts/demo.sh: build_map.sh, then
+#      calibrate_rig.sh with the database), every step through the build's
+#      extended colmap: `colmap feature_extractor`, `colmap mapper`, ...,
+#      `colmap rig_calibrator` (checked in the scripts' logs);
 #   2. accuracy: every camera within 0.5 degrees, 2 cm and 1 % focal length
-#      of the ground truth (rig_calibrator evaluate);
+#      of the ground truth (colmap rig_calibrator evaluate);
 #   3. outputs: `colmap model_analyzer` reads the model, and
 #      check_calibration_outputs checks that the model, rigs/frames,
 #      rig_config.json and camchain.yaml agree with calibration_summary.json
@@ -15,10 +17,10 @@
 #      within 1e-6 relative).
 #
 # Usage: tests/e2e/rendered_rig_e2e.sh BUILD_DIR [WORK_DIR]
-#   BUILD_DIR  the build tree: rig_calibrator and tests/check_calibration_outputs
+#   BUILD_DIR  the build tree: colmap and tests/check_calibration_outputs
 #   WORK_DIR   scratch folder (default: a fresh temporary folder, removed on
 #              success)
-# Environment: COLMAP (colmap 3.8 binary; default as scripts/build_map.sh).
+# COLMAP in the environment is ignored: the test is of the build's colmap.
 set -euo pipefail
 
 [[ $# -ge 1 ]] || { echo "usage: $0 BUILD_DIR [WORK_DIR]" >&2; exit 2; }
@@ -27,31 +29,34 @@ build="$(cd "$1" && pwd)"
 work="${2:-$(mktemp -d)}"
 fail() { echo "[e2e] FAILED: $*" >&2; echo "[e2e] outputs kept in $work" >&2; exit 1; }
 
-rig_calibrator="$build/rig_calibrator"
+colmap="$build/colmap"
 checker="$build/tests/check_calibration_outputs"
-[[ -x "$rig_calibrator" ]] || fail "no $rig_calibrator: build the project first"
+[[ -x "$colmap" ]] || fail "no $colmap: build the project first"
 [[ -x "$checker" ]] || fail "no $checker: build the target check_calibration_outputs"
-default_colmap="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}/colmap-3.8/bin/colmap"
-if [[ -n "${COLMAP:-}" ]]; then
-  colmap="$COLMAP"
-elif [[ -x "$default_colmap" ]]; then
-  colmap="$default_colmap"
-else
-  colmap="$(command -v colmap)" || fail "no colmap binary: set COLMAP or run scripts/setup_deps.sh"
-fi
 
 start=$SECONDS
-DEMO_SKIP_BUILD=1 RIG_CALIBRATOR_BUILD_DIR="$build" DEMO_PRESET=ring5 \
-  DEMO_SCENE=room DEMO_MAP_IMAGES=40 DEMO_FRAMESETS=8 MAP_OVERLAP=4 \
-  RIG_MAX_FEATURES=2048 bash "$repo/scripts/demo.sh" "$work/demo" ||
-  fail "the demo pipeline"
+mkdir -p "$work"
+demo_log="$work/demo.log"
+status=0
+COLMAP="$colmap" DEMO_SKIP_BUILD=1 RIG_CALIBRATOR_BUILD_DIR="$build" \
+  DEMO_PRESET=ring5 DEMO_SCENE=room DEMO_MAP_IMAGES=40 DEMO_FRAMESETS=8 \
+  MAP_OVERLAP=4 RIG_MAX_FEATURES=2048 bash "$repo/scripts/demo.sh" "$work/demo" 2>&1 |
+  tee "$demo_log" || status=${PIPESTATUS[0]}
+[[ "$status" -eq 0 ]] || fail "the demo pipeline"
 demo_seconds=$((SECONDS - start))
+# The map's and the calibration's COLMAP steps and the calibration ran
+# through the build's colmap.
+grep -qxF "[build_map] colmap: $colmap" "$demo_log" ||
+  fail "build_map.sh did not run $colmap (log: $demo_log)"
+grep -qxF "[calibrate_rig] colmap: $colmap; calibration: $colmap rig_calibrator" "$demo_log" ||
+  fail "calibrate_rig.sh did not run $colmap and $colmap rig_calibrator (log: $demo_log)"
+echo "[e2e] every COLMAP step and the calibration ran through $colmap"
 calibration="$work/demo/rig/calibration"
 truth="$work/demo/dataset/ground_truth"
 
 # 2. Accuracy against the ground truth.
 errors="$work/errors.json"
-"$rig_calibrator" evaluate --reference_path "$truth/rig_config.json" \
+"$colmap" rig_calibrator evaluate --reference_path "$truth/rig_config.json" \
   --calibration_path "$calibration" --output_path "$errors" \
   > /dev/null || fail "evaluate"
 
@@ -71,7 +76,8 @@ awk -v r="$rotation" -v c="$center" -v f="$focal" \
   'BEGIN { exit !(r < 0.5 && c < 0.02 && f < 1.0) }' ||
   fail "errors above the bounds (0.5 deg, 0.02 m, 1 %)"
 
-# 3. The outputs, read by COLMAP and by the project's readers.
+# 3. The outputs, read by COLMAP (the build's colmap model_analyzer is
+# COLMAP's) and by the project's readers.
 "$colmap" model_analyzer --path "$calibration" > "$work/model_analyzer.log" 2>&1 ||
   fail "colmap model_analyzer cannot read $calibration (log: $work/model_analyzer.log)"
 registered=$(sed -n 's/.*Registered images: *\([0-9]*\).*/\1/p' "$work/model_analyzer.log" | head -n 1)
@@ -97,7 +103,7 @@ echo "[e2e] check_calibration_outputs rejects the true rig's rig_config.json in 
 camera_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
 rerun="$work/rerun"
 start=$SECONDS
-"$rig_calibrator" --correspondences_path "$calibration/correspondences.txt" \
+"$colmap" rig_calibrator --correspondences_path "$calibration/correspondences.txt" \
   --input_path "$work/demo/map/sparse/0" --output_path "$rerun" \
   --RigCalibrator.camera_model "$camera_models" > "$work/rerun.log" 2>&1 ||
   fail "the re-run from $calibration/correspondences.txt (log: $work/rerun.log)"
