@@ -37,7 +37,7 @@ bool ReadBinaryRecords(const std::string& path,
     offset += size;
     return true;
   };
-  const std::string prefix = path + " is not a COLMAP cameras.bin: ";
+  const std::string prefix = path + " is not a COLMAP binary model file: ";
   uint64_t count = 0;
   if (!read(&count, sizeof(count))) {
     *error = prefix + "it ends inside the camera count";
