@@ -99,9 +99,10 @@ int ColmapSchemaUserVersion(const ColmapSchema schema) {
 }
 
 ModernDatabase::ModernDatabase(const std::string& path,
-                               const ColmapSchema schema)
+                               const ColmapSchema schema, const bool create)
     : schema_(schema) {
   EXPECT_EQ(sqlite3_open(path.c_str(), &database_), SQLITE_OK) << path;
+  if (!create) return;
   Execute(std::string("PRAGMA journal_mode = WAL;") + kCommonTables +
           (HasDescriptorType(schema) ? kTables4x : kTables3x) +
           "PRAGMA user_version = " +

@@ -29,8 +29,11 @@ int ColmapSchemaUserVersion(ColmapSchema schema);
 class ModernDatabase {
  public:
   // Creates the database at `path` (which must not exist), in WAL journaling
-  // as COLMAP leaves it. Fails the test on an SQLite error.
-  ModernDatabase(const std::string& path, ColmapSchema schema);
+  // as COLMAP leaves it; or, with `create` false, opens the existing database
+  // of that schema at `path` (a copy the test owns). Fails the test on an
+  // SQLite error.
+  ModernDatabase(const std::string& path, ColmapSchema schema,
+                 bool create = true);
   ~ModernDatabase();
   ModernDatabase(const ModernDatabase&) = delete;
   ModernDatabase& operator=(const ModernDatabase&) = delete;
