@@ -18,7 +18,8 @@ void AddInputOutputOptions(po::options_description* description,
                  "folder of the rig images, one sub-folder per camera "
                  "(cam0/, cam1/, ...)");
   AddUnsetOption(description, "input_path", &o->input_path,
-                 "the map: a COLMAP sparse model folder (binary or text, of COLMAP 3.8 to 4.1)");
+                 "the map: a COLMAP sparse model folder (binary or text, of "
+                 "COLMAP 3.8 to 4.1)");
   AddUnsetOption(description, "output_path", &o->output_path,
                  "output folder (written completely or not at all)");
   AddUnsetOption(description, "correspondences_path", &o->correspondences_path,

@@ -309,8 +309,7 @@ RigLayoutOptions DatabaseFrames(const DatabaseReader& database,
   }
   if (!grouped) return RigLayoutOptions();
   frames.frame_source =
-      "the database's frames (COLMAP rig_configurator) in " +
-      database.path();
+      "the database's frames (COLMAP rig_configurator) in " + database.path();
   return frames;
 }
 
@@ -326,8 +325,7 @@ KnownRigPrior DatabaseRigPrior(
                                                 colmap::kInvalidCameraId);
   std::vector<bool> shared(dataset.cameras.size(), true);
   for (const RigImage& image : dataset.images) {
-    const colmap::camera_t camera_id =
-        cameras_by_name.at(image.name).camera_id;
+    const colmap::camera_t camera_id = cameras_by_name.at(image.name).camera_id;
     colmap::camera_t& known = database_camera[image.camera_index];
     if (known != colmap::kInvalidCameraId && known != camera_id) {
       shared[image.camera_index] = false;

@@ -54,8 +54,7 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
   if (!summary.known_rig_source.empty()) {
     std::cout << "  against the known rig of " << summary.known_rig_source
               << " (cam_from_" << summary.known_rig_reference_camera << "):\n";
-    for (const KnownPoseComparison& comparison :
-         summary.known_rig_comparison) {
+    for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
       std::cout << "    " << std::left << std::setw(8) << comparison.camera
                 << std::right << " rotation " << std::setprecision(3)
                 << comparison.rotation_error_deg << " deg, translation "

@@ -144,8 +144,7 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     Json known = {{"source", summary.known_rig_source},
                   {"reference_camera", summary.known_rig_reference_camera},
                   {"cameras", Json::array()}};
-    for (const KnownPoseComparison& comparison :
-         summary.known_rig_comparison) {
+    for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
       known["cameras"].push_back(
           {{"name", comparison.camera},
            {"rotation_error_deg", number(comparison.rotation_error_deg)},

@@ -20,8 +20,7 @@ void AppendBinary(const T value, std::string* bytes) {
 }
 
 bool ReadBinaryRecords(const std::string& path,
-                       std::vector<CameraRecord>* cameras,
-                       std::string* error) {
+                       std::vector<CameraRecord>* cameras, std::string* error) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
     *error = "cannot open " + path;
@@ -96,8 +95,8 @@ bool ReadTextRecords(const std::string& path,
     int64_t camera_id = 0;
     int64_t width = 0;
     int64_t height = 0;
-    camera.model_id = items.size() >= 2 ? ColmapCameraModelIdFromName(items[1])
-                                        : -1;
+    camera.model_id =
+        items.size() >= 2 ? ColmapCameraModelIdFromName(items[1]) : -1;
     if (items.size() < 4 || !ParseInt64(items[0], &camera_id) ||
         camera_id < 0 || camera_id >= std::numeric_limits<uint32_t>::max() ||
         camera.model_id < 0 || !ParseInt64(items[2], &width) || width < 0 ||
@@ -135,8 +134,7 @@ bool ReadTextRecords(const std::string& path,
 }  // namespace
 
 bool ReadCameraRecords(const std::string& path, const bool binary,
-                       std::vector<CameraRecord>* cameras,
-                       std::string* error) {
+                       std::vector<CameraRecord>* cameras, std::string* error) {
   cameras->clear();
   return binary ? ReadBinaryRecords(path, cameras, error)
                 : ReadTextRecords(path, cameras, error);

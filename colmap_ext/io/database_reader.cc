@@ -3,8 +3,6 @@
 #include <colmap/base/camera_models.h>
 #include <sqlite3.h>
 
-#include "colmap_ext/io/colmap_camera_models.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cstring>
@@ -12,6 +10,8 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+
+#include "colmap_ext/io/colmap_camera_models.h"
 
 namespace rig_calibrator {
 namespace {
@@ -52,8 +52,9 @@ std::set<std::string> TableColumns(sqlite3* database,
                                    const std::string& table) {
   std::set<std::string> columns;
   sqlite3_stmt* statement = nullptr;
-  if (sqlite3_prepare_v2(database, ("PRAGMA table_info(" + table + ");").c_str(),
-                         -1, &statement, nullptr) == SQLITE_OK) {
+  if (sqlite3_prepare_v2(database,
+                         ("PRAGMA table_info(" + table + ");").c_str(), -1,
+                         &statement, nullptr) == SQLITE_OK) {
     while (sqlite3_step(statement) == SQLITE_ROW) {
       columns.insert(
           reinterpret_cast<const char*>(sqlite3_column_text(statement, 1)));
@@ -391,7 +392,8 @@ std::string DatabaseReader::SchemaDescription() const {
 bool DatabaseReader::ReadRigsAndFrames(std::string* error) {
   if (!has_rigs_) return true;
   auto fail = [&](const std::string& table) {
-    *error = "cannot read the " + table + " table: " + sqlite3_errmsg(database_);
+    *error =
+        "cannot read the " + table + " table: " + sqlite3_errmsg(database_);
     return false;
   };
   std::unordered_map<uint32_t, size_t> rig_index;

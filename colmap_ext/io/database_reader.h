@@ -21,8 +21,6 @@
 #include <colmap/feature/types.h>
 #include <colmap/util/types.h>
 
-#include "src/geometry/rigid3d.h"
-
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -30,6 +28,8 @@
 #include <string>
 #include <unordered_map>
 #include <vector>
+
+#include "src/geometry/rigid3d.h"
 
 struct sqlite3;
 struct sqlite3_stmt;
@@ -168,7 +168,7 @@ class DatabaseReader {
   std::string path_;
   sqlite3* database_ = nullptr;
   int user_version_ = 0;
-  bool has_rigs_ = false;             // COLMAP >= 3.12
+  bool has_rigs_ = false;               // COLMAP >= 3.12
   bool descriptors_have_type_ = false;  // COLMAP >= 4.0
   bool images_have_priors_ = false;     // COLMAP <= 3.9
   std::vector<DatabaseRig> rigs_;

@@ -237,9 +237,9 @@ bool ReadWithColmap(const fs::path& folder, const bool binary,
         return false;
       }
     }
-    if (!WriteCameraRecords((temporary->path() / ("cameras" + extension))
-                                .string(),
-                            binary, readable, error)) {
+    if (!WriteCameraRecords(
+            (temporary->path() / ("cameras" + extension)).string(), binary,
+            readable, error)) {
       return false;
     }
     read_folder = temporary->path();
@@ -336,9 +336,8 @@ bool CheckRigsAndFrames(const std::string& path,
     const auto count = num_frames_of_image.find(image_id);
     if (count == num_frames_of_image.end() || count->second != 1) {
       *error = prefix + "the image " + map.Image(image_id).Name() + " is in " +
-               std::to_string(count == num_frames_of_image.end()
-                                  ? 0
-                                  : count->second) +
+               std::to_string(
+                   count == num_frames_of_image.end() ? 0 : count->second) +
                " frames; COLMAP >= 3.12 needs every registered image in one "
                "frame";
       return false;
@@ -420,9 +419,9 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
     }
   }
   std::vector<CameraRecord> cameras;
-  if (!ReadCameraRecords((folder / (binary ? "cameras.bin" : "cameras.txt"))
-                             .string(),
-                         binary, &cameras, error)) {
+  if (!ReadCameraRecords(
+          (folder / (binary ? "cameras.bin" : "cameras.txt")).string(), binary,
+          &cameras, error)) {
     return false;
   }
   if (binary && (!CheckImagesBinary(folder / "images.bin", error) ||
@@ -451,8 +450,7 @@ bool RestoreNewerModelCameras(const std::string& folder, const bool binary,
                               const std::vector<CameraRecord>& cameras,
                               std::string* error) {
   if (cameras.empty()) return true;
-  const std::string path =
-      folder + (binary ? "/cameras.bin" : "/cameras.txt");
+  const std::string path = folder + (binary ? "/cameras.bin" : "/cameras.txt");
   std::vector<CameraRecord> written;
   if (!ReadCameraRecords(path, binary, &written, error)) return false;
   for (CameraRecord& record : written) {

@@ -265,7 +265,8 @@ bool GroupGivenFrames(const std::vector<std::string>& image_names,
     }
     images.push_back(static_cast<int>(i));
   }
-  for (auto& entry : frame_images) framesets->push_back(std::move(entry.second));
+  for (auto& entry : frame_images)
+    framesets->push_back(std::move(entry.second));
   std::sort(framesets->begin(), framesets->end(),
             [&](const std::vector<int>& a, const std::vector<int>& b) {
               return NaturalLess(keys[a.front()], keys[b.front()]);

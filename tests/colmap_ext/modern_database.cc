@@ -170,13 +170,14 @@ uint32_t ModernDatabase::AddImage(const std::string& name,
   const uint32_t image_id =
       static_cast<uint32_t>(sqlite3_last_insert_rowid(database_));
   const std::string camera = std::to_string(camera_id);
-  Execute("INSERT INTO frames (rig_id) SELECT rig_id FROM rigs WHERE "
-          "ref_sensor_id = " +
-          camera +
-          " AND ref_sensor_type = 0;"
-          "INSERT INTO frame_data (frame_id, data_id, sensor_id, sensor_type) "
-          "VALUES (last_insert_rowid(), " +
-          std::to_string(image_id) + ", " + camera + ", 0);");
+  Execute(
+      "INSERT INTO frames (rig_id) SELECT rig_id FROM rigs WHERE "
+      "ref_sensor_id = " +
+      camera +
+      " AND ref_sensor_type = 0;"
+      "INSERT INTO frame_data (frame_id, data_id, sensor_id, sensor_type) "
+      "VALUES (last_insert_rowid(), " +
+      std::to_string(image_id) + ", " + camera + ", 0);");
   return image_id;
 }
 
@@ -292,7 +293,8 @@ void ModernDatabase::GroupFrames(
   for (const std::vector<uint32_t>& frame : frames) {
     Execute("INSERT INTO frames (rig_id) VALUES (" + std::to_string(rig_id) +
             ");");
-    const std::string frame_id = std::to_string(sqlite3_last_insert_rowid(database_));
+    const std::string frame_id =
+        std::to_string(sqlite3_last_insert_rowid(database_));
     for (const uint32_t image_id : frame) {
       const std::string image = std::to_string(image_id);
       Execute(

@@ -45,7 +45,8 @@ class ModernDatabase {
   // An image and its trivial frame (in the camera's trivial rig).
   uint32_t AddImage(const std::string& name, uint32_t camera_id);
   // Keypoints: rows x cols float32 (cols 2, 4 or 6), row-major.
-  void AddKeypoints(uint32_t image_id, int cols, const std::vector<float>& data);
+  void AddKeypoints(uint32_t image_id, int cols,
+                    const std::vector<float>& data);
   // SIFT descriptors (uint8, 128 per row); 4.x stores `type` 0.
   void AddSiftDescriptors(uint32_t image_id, const std::vector<uint8_t>& data);
   // Descriptors of another type (4.x only): rows x cols float32.
@@ -54,10 +55,9 @@ class ModernDatabase {
   // Raw matches and a verified geometry (config 2 = CALIBRATED, 9 =
   // CALIBRATED_RIG since 3.12) of the pair, inliers as (idx1, idx2) of
   // (image_id1, image_id2); stored as COLMAP does, smaller id first.
-  void AddTwoViewGeometry(uint32_t image_id1, uint32_t image_id2,
-                          const std::vector<std::pair<uint32_t, uint32_t>>&
-                              inliers,
-                          int config);
+  void AddTwoViewGeometry(
+      uint32_t image_id1, uint32_t image_id2,
+      const std::vector<std::pair<uint32_t, uint32_t>>& inliers, int config);
   // COLMAP's rig_configurator: one rig of `camera_ids` (the first is the
   // reference; sensor_from_rig per other camera, unknown when empty)
   // replacing their trivial rigs, and one frame per group of image ids

@@ -336,8 +336,8 @@ void WriteColmap41Database(const std::string& path, const int descriptor_type,
       database.AddCamera(2, 640, 480, {500, 320, 240, 0}, false);
   const uint32_t cam0 =
       database.AddCamera(cam0_model_id, 640, 480, cam0_params, true);
-  const uint32_t cam1 = database.AddCamera(
-      4, 640, 480, {480, 480, 320, 240, 0, 0, 0, 0}, false);
+  const uint32_t cam1 =
+      database.AddCamera(4, 640, 480, {480, 480, 320, 240, 0, 0, 0, 0}, false);
   for (const std::string name :
        {"map/0.png", "map/1.png", "map/2.png", "cam0/0001.png", "cam0/0002.png",
         "cam1/0001.png", "cam1/0002.png"}) {

@@ -73,11 +73,12 @@ class Colmap411CalibrationTest : public ::testing::Test {
   // prints the errors.
   void ExpectCloseToGroundTruth(const std::string& output) {
     const std::string errors = temp_.File("errors.json");
-    ASSERT_EQ(testing::RunCommand(
-                  &RunEvaluate,
-                  {"--reference_path", DataDir() + "/ground_truth/rig_config.json",
-                   "--calibration_path", output, "--output_path", errors}),
-              EXIT_SUCCESS);
+    ASSERT_EQ(
+        testing::RunCommand(
+            &RunEvaluate,
+            {"--reference_path", DataDir() + "/ground_truth/rig_config.json",
+             "--calibration_path", output, "--output_path", errors}),
+        EXIT_SUCCESS);
     std::ifstream file(errors);
     const nlohmann::json cameras = nlohmann::json::parse(file)["cameras"];
     ASSERT_EQ(cameras.size(), 5u);
@@ -134,9 +135,9 @@ void ExpectColmap41RigsAndFrames(const std::string& output,
     EXPECT_EQ(a.rig_id, b.rig_id);
     ASSERT_EQ(a.data.size(), 1u);
     EXPECT_EQ(a.data[0].data_id, b.data[0].data_id);
-    EXPECT_LT((a.rig_from_world.ToMatrix() - b.rig_from_world.ToMatrix())
-                  .norm(),
-              1e-12);
+    EXPECT_LT(
+        (a.rig_from_world.ToMatrix() - b.rig_from_world.ToMatrix()).norm(),
+        1e-12);
   }
   for (size_t f = 30; f < 34; ++f) {
     EXPECT_EQ(written.frames[f].rig_id, written.rigs[1].rig_id);
@@ -144,9 +145,9 @@ void ExpectColmap41RigsAndFrames(const std::string& output,
   }
 }
 
-class Colmap411MapTypeTest
-    : public Colmap411CalibrationTest,
-      public ::testing::WithParamInterface<std::string> {};
+class Colmap411MapTypeTest : public Colmap411CalibrationTest,
+                             public ::testing::WithParamInterface<std::string> {
+};
 
 TEST_P(Colmap411MapTypeTest, CalibratesWithoutTouchingTheInputs) {
   const std::string map = DataDir() + "/map/" + GetParam();
@@ -211,16 +212,16 @@ TEST_F(Colmap411CalibrationTest, FramesAndKnownPosesFromTheDatabase) {
     ASSERT_TRUE(reader.Open(database, &error)) << error;
     for (int c = 0; c < 5; ++c) {
       for (int f = 0; f < 4; ++f) {
-        const std::string name = "cam" + std::to_string(c) + "/00000" +
-                                 std::to_string(f) + ".jpg";
+        const std::string name =
+            "cam" + std::to_string(c) + "/00000" + std::to_string(f) + ".jpg";
         const DatabaseImage* image = reader.FindImageWithName(name);
         ASSERT_NE(image, nullptr) << name;
         camera_ids[c] = image->camera_id;
         frames[f].push_back(image->image_id);
-        const std::string renamed =
-            c == 0 ? name
-                   : "cam" + std::to_string(c) + "/c" + std::to_string(c) +
-                         "_00000" + std::to_string(f) + ".jpg";
+        const std::string renamed = c == 0 ? name
+                                           : "cam" + std::to_string(c) + "/c" +
+                                                 std::to_string(c) + "_00000" +
+                                                 std::to_string(f) + ".jpg";
         fs::create_directories(fs::path(images + "/" + renamed).parent_path());
         fs::copy_file(DataDir() + "/rig_images/" + name,
                       images + "/" + renamed);
@@ -272,8 +273,7 @@ TEST_F(Colmap411CalibrationTest, FramesAndKnownPosesFromTheDatabase) {
   // The comparison with the database's rig in the summary: the ground truth,
   // so within the same bounds.
   std::ifstream summary_file(output + "/calibration_summary.json");
-  const nlohmann::json known =
-      nlohmann::json::parse(summary_file)["known_rig"];
+  const nlohmann::json known = nlohmann::json::parse(summary_file)["known_rig"];
   ASSERT_TRUE(known.is_object());
   EXPECT_EQ(known["reference_camera"], "cam0");
   ASSERT_EQ(known["cameras"].size(), 4u);

@@ -43,8 +43,8 @@ class ModernDatabaseTest : public ::testing::TestWithParam<ColmapSchema> {
   void SetUp() override {
     path_ = temp_dir_.File("database.db");
     ModernDatabase database(path_, GetParam());
-    map_camera_ = database.AddCamera(kPinhole, 640, 480, {400, 400, 320, 240},
-                                     true);
+    map_camera_ =
+        database.AddCamera(kPinhole, 640, 480, {400, 400, 320, 240}, true);
     cam0_ = database.AddCamera(kOpencv, 768, 576,
                                {420, 421, 384, 288, -0.1, 0.01, 0, 0}, false);
     cam1_ = database.AddCamera(kFisheye, 640, 480, {300, 301, 320, 240}, true);
@@ -201,17 +201,15 @@ TEST_P(ModernDatabaseTest, LeavesTheWalDatabaseUntouched) {
   EXPECT_EQ(testing::ListFolder(temp_dir_.path()), files_before);
 }
 
-INSTANTIATE_TEST_SUITE_P(Schemas, ModernDatabaseTest,
-                         ::testing::Values(ColmapSchema::k3_12,
-                                           ColmapSchema::k3_13,
-                                           ColmapSchema::k4_0,
-                                           ColmapSchema::k4_1),
-                         [](const auto& info) {
-                           std::string name =
-                               testing::ColmapSchemaName(info.param);
-                           name[1] = '_';
-                           return "Colmap" + name;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Schemas, ModernDatabaseTest,
+    ::testing::Values(ColmapSchema::k3_12, ColmapSchema::k3_13,
+                      ColmapSchema::k4_0, ColmapSchema::k4_1),
+    [](const auto& info) {
+      std::string name = testing::ColmapSchemaName(info.param);
+      name[1] = '_';
+      return "Colmap" + name;
+    });
 
 TEST(ModernDatabaseErrorsTest, RejectsNonSiftDescriptorsNamingTheType) {
   testing::ScopedTempDir temp_dir;

@@ -41,8 +41,7 @@ TEST_P(Colmap411MapTest, ReadsTheMapWithItsRigsAndFrames) {
 INSTANTIATE_TEST_SUITE_P(BinaryAndText, Colmap411MapTest,
                          ::testing::Values("sparse/0", "sparse_txt"),
                          [](const auto& info) {
-                           return info.param == "sparse/0" ? "Binary"
-                                                           : "Text";
+                           return info.param == "sparse/0" ? "Binary" : "Text";
                          });
 
 class MapCopyTest : public ::testing::Test {
@@ -101,9 +100,9 @@ TEST_F(MapCopyTest, HoldsCamerasOfNewerModelsAsPlaceholders) {
                                          info.newer_model_cameras, &error))
         << error;
     std::vector<CameraRecord> cameras;
-    ASSERT_TRUE(ReadCameraRecords(
-        written + (binary ? "/cameras.bin" : "/cameras.txt"), binary, &cameras,
-        &error))
+    ASSERT_TRUE(
+        ReadCameraRecords(written + (binary ? "/cameras.bin" : "/cameras.txt"),
+                          binary, &cameras, &error))
         << error;
     ASSERT_EQ(cameras.size(), 1u);
     EXPECT_EQ(cameras[0].model_id, 15);

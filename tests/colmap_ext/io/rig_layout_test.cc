@@ -49,9 +49,8 @@ TEST(RigLayout, SameFileNamesAcrossCameraFolders) {
 TEST(RigLayout, GivenFramesAreTheFramesets) {
   // COLMAP rig_configurator's frames: the names after the prefix differ, the
   // timestamp tolerance is not used, an image without a frame is alone.
-  const std::vector<std::string> names = {"cam0/a.png", "cam0/b.png",
-                                          "cam1/x.png", "cam1/y.png",
-                                          "cam1/z.png"};
+  const std::vector<std::string> names = {
+      "cam0/a.png", "cam0/b.png", "cam1/x.png", "cam1/y.png", "cam1/z.png"};
   RigLayoutOptions options;
   options.frame_ids = {7, 3, 3, 7, -1};
   options.frame_source = "the test's frames";
