@@ -10,9 +10,10 @@
 // also for the WAL-mode files of COLMAP 4.x), checks the schema first and
 // turns every problem into an error message.
 //
-// The schemas differ (see README, "COLMAP versions"): 3.12 drops the prior_*
-// columns of `images` and adds `rigs`, `rig_sensors`, `frames`, `frame_data`
-// and `pose_priors`; 4.0 adds a `type` column to `descriptors` (0 = SIFT).
+// The schemas differ (see README, "COLMAP versions"): 3.10 moves the prior_*
+// columns of `images` into `pose_priors`; 3.12 adds `rigs`, `rig_sensors`,
+// `frames` and `frame_data`; 4.0 adds a `type` column to `descriptors`
+// (0 = SIFT).
 // Camera model ids above 10 (COLMAP >= 3.11) are read as DatabaseCamera but
 // cannot become a colmap::Camera of COLMAP 3.8.
 #pragma once
