@@ -239,6 +239,35 @@ TEST_F(DatabaseReaderTest, DescribesTheColmap38Schema) {
   EXPECT_TRUE(reader.Frames().empty());
 }
 
+TEST_F(DatabaseReaderTest, DescribesTheColmap310Schema) {
+  // COLMAP 3.10 and 3.11: pose priors moved out of the images table, no
+  // rigs yet.
+  const std::string path = temp_dir_.File("colmap310.db");
+  ExecuteSql(path,
+             "CREATE TABLE cameras (camera_id INTEGER PRIMARY KEY, model "
+             "INTEGER, width INTEGER, height INTEGER, params BLOB, "
+             "prior_focal_length INTEGER);"
+             "CREATE TABLE images (image_id INTEGER PRIMARY KEY, name TEXT, "
+             "camera_id INTEGER);"
+             "CREATE TABLE pose_priors (image_id INTEGER PRIMARY KEY, position "
+             "BLOB, coordinate_system INTEGER);"
+             "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER, cols "
+             "INTEGER, data BLOB);"
+             "CREATE TABLE descriptors (image_id INTEGER, rows INTEGER, cols "
+             "INTEGER, data BLOB);"
+             "CREATE TABLE matches (pair_id INTEGER, rows INTEGER, cols "
+             "INTEGER, data BLOB);"
+             "CREATE TABLE two_view_geometries (pair_id INTEGER, rows INTEGER, "
+             "cols INTEGER, data BLOB, config INTEGER);"
+             "INSERT INTO images VALUES (1, 'cam0/1.png', 1);");
+  DatabaseReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.Open(path, &error)) << error;
+  EXPECT_EQ(reader.SchemaDescription(),
+            "COLMAP 3.10 or 3.11 schema (user_version 0)");
+  EXPECT_EQ(reader.Images().size(), 1u);
+}
+
 TEST_F(DatabaseReaderTest, RejectsPartialRigTables) {
   ExecuteSql(path_,
              "CREATE TABLE rigs (rig_id INTEGER PRIMARY KEY);"
