@@ -17,17 +17,22 @@ namespace {
 
 // The map of --input_path (empty without one).
 bool ReadInputMap(const CalibrateOptions& options, colmap::Reconstruction* map,
-                  std::string* error) {
+                  MapReadInfo* info, std::string* error) {
   if (options.input_path.empty()) return true;
   std::cout << "== Reading the map " << options.input_path << std::endl;
-  if (!ReadMap(options.input_path, map, error)) return false;
+  if (!ReadMap(options.input_path, map, info, error)) return false;
   std::cout << "  " << map->NumRegImages() << " images, " << map->NumPoints3D()
             << " points" << std::endl;
+  for (const std::string& note : info->notes) {
+    std::cout << "  " << note << std::endl;
+  }
   return true;
 }
 
-RigOutputOptions MakeOutputOptions(const CalibrateOptions& options) {
+RigOutputOptions MakeOutputOptions(const CalibrateOptions& options,
+                                   const MapReadInfo& map_info) {
   RigOutputOptions output_options;
+  output_options.newer_model_map_cameras = map_info.newer_model_cameras;
   output_options.output_type = options.output_type;
   output_options.overwrite = options.overwrite;
   for (const std::string& input :
@@ -51,16 +56,19 @@ int RunCalibrate(int argc, char** argv) {
   std::string error;
   PipelineOptions pipeline;
   colmap::Reconstruction map;
+  MapReadInfo map_info;
   if (!MakePipelineOptions(&options, &pipeline, &error) ||
-      !ReadInputMap(options, &map, &error)) {
+      !ReadInputMap(options, &map, &map_info, &error)) {
     return PrintError(error);
   }
   RigDataset dataset;
   RigLayout layout;
+  KnownRigPrior known_rig;
   const bool loaded =
       options.FromCorrespondences()
           ? LoadFromCorrespondences(options, &dataset, &layout, &error)
-          : LoadFromDatabase(options, map, &dataset, &layout, &error);
+          : LoadFromDatabase(options, map, &dataset, &layout, &error,
+                             &known_rig);
   if (!loaded) return PrintError(error);
 
   RigCalibration calibration;
@@ -70,11 +78,11 @@ int RunCalibrate(int argc, char** argv) {
     return PrintError("calibration failed: " + report.error);
   }
   const CalibrationSummary summary = MakeCalibrationSummary(
-      dataset, calibration, layout.camera_prefixes, report);
+      dataset, calibration, layout.camera_prefixes, report, known_rig);
   std::vector<std::string> notes;
   if (!WriteRigOutput(options.output_path, map, dataset, calibration,
                       layout.camera_prefixes, summary,
-                      MakeOutputOptions(options), &notes, &error)) {
+                      MakeOutputOptions(options, map_info), &notes, &error)) {
     return PrintError("writing the output failed, nothing was written: " +
                       error);
   }

@@ -12,13 +12,14 @@ namespace po = boost::program_options;
 void AddInputOutputOptions(po::options_description* description,
                            CalibrateOptions* o) {
   AddUnsetOption(description, "database_path", &o->database_path,
-                 "COLMAP 3.8 database with the map images and the rig "
-                 "images' features (never modified)");
+                 "COLMAP database (of COLMAP 3.8 to 4.1) with the map images "
+                 "and the rig images' SIFT features (never modified)");
   AddUnsetOption(description, "image_path", &o->image_path,
                  "folder of the rig images, one sub-folder per camera "
                  "(cam0/, cam1/, ...)");
   AddUnsetOption(description, "input_path", &o->input_path,
-                 "the map: a COLMAP sparse model folder (binary or text)");
+                 "the map: a COLMAP sparse model folder (binary or text, of "
+                 "COLMAP 3.8 to 4.1)");
   AddUnsetOption(description, "output_path", &o->output_path,
                  "output folder (written completely or not at all)");
   AddUnsetOption(description, "correspondences_path", &o->correspondences_path,

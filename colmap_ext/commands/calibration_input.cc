@@ -118,8 +118,9 @@ bool CameraModels(const std::string& value,
 bool MakeDataset(const CalibrateOptions& options, const std::string& source,
                  const std::vector<std::string>& image_names,
                  const std::vector<std::pair<int, int>>& image_sizes,
-                 RigDataset* dataset, RigLayout* layout, std::string* error) {
-  RigLayoutOptions layout_options;
+                 RigDataset* dataset, RigLayout* layout, std::string* error,
+                 const RigLayoutOptions& frames = RigLayoutOptions()) {
+  RigLayoutOptions layout_options = frames;
   layout_options.timestamp_tolerance = options.timestamp_tolerance;
   if (!options.camera_prefixes.empty()) {
     boost::split(layout_options.camera_prefixes, options.camera_prefixes,
@@ -242,7 +243,7 @@ bool ReadRigImageCameras(const CalibrateOptions& options,
                          const colmap::Reconstruction& map,
                          const std::vector<std::string>& image_names,
                          std::vector<std::pair<int, int>>* image_sizes,
-                         std::map<std::string, colmap::Camera>* cameras_by_name,
+                         std::map<std::string, DatabaseCamera>* cameras_by_name,
                          std::string* error) {
   std::vector<std::string> missing;
   for (const std::string& name : image_names) {
@@ -252,10 +253,10 @@ bool ReadRigImageCameras(const CalibrateOptions& options,
       image_sizes->emplace_back(0, 0);
       continue;
     }
-    colmap::Camera camera;
+    DatabaseCamera camera;
     if (!database.ReadCamera(image->camera_id, &camera, error)) return false;
-    image_sizes->emplace_back(static_cast<int>(camera.Width()),
-                              static_cast<int>(camera.Height()));
+    image_sizes->emplace_back(static_cast<int>(camera.width),
+                              static_cast<int>(camera.height));
     (*cameras_by_name)[name] = camera;
   }
   if (!missing.empty()) {
@@ -274,6 +275,112 @@ bool ReadRigImageCameras(const CalibrateOptions& options,
           "image " + name +
           " is both a rig image and a registered map image: keep the rig "
           "images out of the map, or give --image_path the rig images only";
+      return false;
+    }
+  }
+  return true;
+}
+
+// The frames of a COLMAP >= 3.12 database that group several of the rig
+// images (COLMAP's rig_configurator was run) as per-image frame ids for the
+// rig layout; empty if every frame holds one rig image at most (the trivial
+// frames of feature_extractor), so that the framesets are found from the
+// names.
+RigLayoutOptions DatabaseFrames(const DatabaseReader& database,
+                                const std::vector<std::string>& image_names) {
+  std::map<colmap::image_t, int64_t> frame_of_image;
+  for (const DatabaseFrame& frame : database.Frames()) {
+    for (const colmap::image_t image_id : frame.image_ids) {
+      frame_of_image[image_id] = frame.frame_id;
+    }
+  }
+  RigLayoutOptions frames;
+  std::map<int64_t, int> num_rig_images;
+  bool grouped = false;
+  for (const std::string& name : image_names) {
+    const DatabaseImage* image = database.FindImageWithName(name);
+    const auto frame = image != nullptr ? frame_of_image.find(image->image_id)
+                                        : frame_of_image.end();
+    frames.frame_ids.push_back(frame != frame_of_image.end() ? frame->second
+                                                             : -1);
+    if (frames.frame_ids.back() >= 0) {
+      grouped |= ++num_rig_images[frames.frame_ids.back()] > 1;
+    }
+  }
+  if (!grouped) return RigLayoutOptions();
+  frames.frame_source =
+      "the database's frames (COLMAP rig_configurator) in " + database.path();
+  return frames;
+}
+
+// The known sensor_from_rig of the database rig that holds the most rig
+// cameras (two at least, its reference camera among them): COLMAP's
+// rig_configurator stores the poses of rig_config.json there. A rig camera
+// is a database camera when all its images share one.
+KnownRigPrior DatabaseRigPrior(
+    const DatabaseReader& database, const RigDataset& dataset,
+    const std::map<std::string, DatabaseCamera>& cameras_by_name) {
+  std::map<colmap::camera_t, int> rig_camera_of;
+  std::vector<colmap::camera_t> database_camera(dataset.cameras.size(),
+                                                colmap::kInvalidCameraId);
+  std::vector<bool> shared(dataset.cameras.size(), true);
+  for (const RigImage& image : dataset.images) {
+    const colmap::camera_t camera_id = cameras_by_name.at(image.name).camera_id;
+    colmap::camera_t& known = database_camera[image.camera_index];
+    if (known != colmap::kInvalidCameraId && known != camera_id) {
+      shared[image.camera_index] = false;
+    }
+    known = camera_id;
+  }
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    if (shared[c]) rig_camera_of[database_camera[c]] = static_cast<int>(c);
+  }
+  KnownRigPrior best;
+  int best_num_known = 0;
+  for (const DatabaseRig& rig : database.Rigs()) {
+    const auto ref = rig_camera_of.find(rig.ref_camera_id);
+    if (ref == rig_camera_of.end()) continue;
+    KnownRigPrior prior;
+    prior.reference_camera = ref->second;
+    prior.cam_from_ref.assign(dataset.cameras.size(), std::nullopt);
+    prior.cam_from_ref[ref->second] = Rigid3d();
+    int num_known = 0;
+    for (const DatabaseRig::Sensor& sensor : rig.cameras) {
+      const auto camera = rig_camera_of.find(sensor.camera_id);
+      if (camera == rig_camera_of.end() || !sensor.sensor_from_rig) continue;
+      prior.cam_from_ref[camera->second] = sensor.sensor_from_rig;
+      ++num_known;
+    }
+    if (num_known > best_num_known) {
+      prior.source = "database " + database.path() + ", rig " +
+                     std::to_string(rig.rig_id) + " (rig_sensors)";
+      best = prior;
+      best_num_known = num_known;
+    }
+  }
+  return best;
+}
+
+// The database camera of every rig camera as a COLMAP 3.8 camera, for the
+// known* methods without --RigCalibrator.intrinsics_path; fails naming the
+// rig camera for a model this build cannot use.
+bool RigDatabaseCameras(const CalibrateOptions& options,
+                        const RigDataset& dataset,
+                        const std::map<std::string, DatabaseCamera>& by_name,
+                        std::vector<colmap::Camera>* cameras,
+                        std::string* error) {
+  cameras->assign(dataset.cameras.size(), colmap::Camera());
+  if (!options.intrinsics_path.empty()) return true;
+  for (const RigImage& image : dataset.images) {
+    const DatabaseCamera& camera = by_name.at(image.name);
+    std::string problem;
+    if (!ToColmapCamera(camera, &(*cameras)[image.camera_index], &problem)) {
+      *error = "method " + options.method + " needs the intrinsics of camera " +
+               dataset.cameras[image.camera_index].name + " from database " +
+               options.database_path + ", but its " + problem +
+               ": give --RigCalibrator.intrinsics_path, or extract its "
+               "features with a model of COLMAP 3.8 (e.g. "
+               "--ImageReader.camera_model OPENCV or OPENCV_FISHEYE)";
       return false;
     }
   }
@@ -318,26 +425,32 @@ bool LocalizeDatasetImages(const CalibrateOptions& options,
 
 bool LoadFromDatabase(const CalibrateOptions& options,
                       const colmap::Reconstruction& map, RigDataset* dataset,
-                      RigLayout* layout, std::string* error) {
+                      RigLayout* layout, std::string* error,
+                      KnownRigPrior* rig_prior) {
   std::vector<std::string> image_names;
   if (!ListImages(options.image_path, &image_names, error)) return false;
   DatabaseReader database;
   if (!database.Open(options.database_path, error)) return false;
+  std::cout << "== Database " << options.database_path << ": "
+            << database.SchemaDescription() << std::endl;
   std::vector<std::pair<int, int>> image_sizes;
-  std::map<std::string, colmap::Camera> cameras_by_name;
+  std::map<std::string, DatabaseCamera> cameras_by_name;
   if (!ReadRigImageCameras(options, database, map, image_names, &image_sizes,
                            &cameras_by_name, error) ||
       !MakeDataset(options,
                    "the rig images under --image_path " + options.image_path,
-                   image_names, image_sizes, dataset, layout, error)) {
+                   image_names, image_sizes, dataset, layout, error,
+                   DatabaseFrames(database, image_names))) {
     return false;
   }
+  if (rig_prior != nullptr) {
+    *rig_prior = DatabaseRigPrior(database, *dataset, cameras_by_name);
+  }
   if (options.KnownIntrinsics()) {
-    std::vector<colmap::Camera> database_cameras(dataset->cameras.size());
-    for (const RigImage& image : dataset->images) {
-      database_cameras[image.camera_index] = cameras_by_name[image.name];
-    }
-    if (!SetKnownIntrinsics(options, database_cameras, dataset, error)) {
+    std::vector<colmap::Camera> database_cameras;
+    if (!RigDatabaseCameras(options, *dataset, cameras_by_name,
+                            &database_cameras, error) ||
+        !SetKnownIntrinsics(options, database_cameras, dataset, error)) {
       return false;
     }
   }

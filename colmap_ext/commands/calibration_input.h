@@ -9,18 +9,23 @@
 #include <string>
 
 #include "colmap_ext/commands/calibrate_options.h"
+#include "colmap_ext/io/calibration_summary.h"
 #include "colmap_ext/io/rig_layout.h"
 #include "src/calibration/rig_dataset.h"
 
 namespace rig_calibrator {
 
 // The images under --image_path, their cameras in --database_path and their
-// correspondences from localizing them against `map`. Prints the rig layout
-// and the localization's progress. False with *error (naming the file or
-// option) on failure.
+// correspondences from localizing them against `map`. The framesets are the
+// database's frames if COLMAP's rig_configurator grouped the rig images
+// (COLMAP >= 3.12), else found from the names. Prints the database's schema,
+// the rig layout and the localization's progress. `rig_prior` (may be null)
+// gets the known sensor_from_rig of the database rig of the rig cameras, if
+// any. False with *error (naming the file or option) on failure.
 bool LoadFromDatabase(const CalibrateOptions& options,
                       const colmap::Reconstruction& map, RigDataset* dataset,
-                      RigLayout* layout, std::string* error);
+                      RigLayout* layout, std::string* error,
+                      KnownRigPrior* rig_prior = nullptr);
 
 // The images and correspondences of --correspondences_path. Prints the rig
 // layout.

@@ -8,9 +8,10 @@ namespace rig_calibrator {
 CalibrationSummary MakeCalibrationSummary(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes,
-    const PipelineReport& report) {
+    const PipelineReport& report, const KnownRigPrior& known_rig) {
   CalibrationSummary summary =
       SummarizeCalibration(dataset, calibration, image_prefixes);
+  CompareWithKnownRig(known_rig, &summary);
   summary.method = CalibrationMethodName(report.used_method);
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
@@ -49,6 +50,18 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
               << ", " << center.z() << ") images " << camera.num_used << "/"
               << camera.num_images << " RMS " << std::setprecision(3)
               << camera.rms_px << " px\n";
+  }
+  if (!summary.known_rig_source.empty()) {
+    std::cout << "  against the known rig of " << summary.known_rig_source
+              << " (cam_from_" << summary.known_rig_reference_camera << "):\n";
+    for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
+      std::cout << "    " << std::left << std::setw(8) << comparison.camera
+                << std::right << " rotation " << std::setprecision(3)
+                << comparison.rotation_error_deg << " deg, translation "
+                << std::setprecision(4) << comparison.translation_error
+                << " map units (known " << comparison.known_translation_norm
+                << ")\n";
+    }
   }
   for (const Diagnostic& diagnostic : report.diagnostics) {
     std::cout << "  " << DiagnosticLevelName(diagnostic.level) << ": "

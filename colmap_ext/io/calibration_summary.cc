@@ -57,6 +57,36 @@ CalibrationSummary SummarizeCalibration(
   return summary;
 }
 
+void CompareWithKnownRig(const KnownRigPrior& prior,
+                         CalibrationSummary* summary) {
+  const int ref = prior.reference_camera;
+  if (ref < 0 || ref >= static_cast<int>(summary->cameras.size()) ||
+      !summary->cameras[ref].cam_from_rig) {
+    return;
+  }
+  summary->known_rig_source = prior.source;
+  summary->known_rig_reference_camera = summary->cameras[ref].name;
+  // cam_from_ref = cam_from_rig * ref_from_rig^-1.
+  const Rigid3d rig_from_ref = summary->cameras[ref].cam_from_rig->Inverse();
+  for (size_t c = 0; c < summary->cameras.size(); ++c) {
+    const CameraSummary& camera = summary->cameras[c];
+    if (static_cast<int>(c) == ref || c >= prior.cam_from_ref.size() ||
+        !prior.cam_from_ref[c] || !camera.cam_from_rig) {
+      continue;
+    }
+    const Rigid3d calibrated = *camera.cam_from_rig * rig_from_ref;
+    const Rigid3d& known = *prior.cam_from_ref[c];
+    KnownPoseComparison comparison;
+    comparison.camera = camera.name;
+    comparison.rotation_error_deg =
+        RotationDifferenceDeg(calibrated.rotation, known.rotation);
+    comparison.translation_error =
+        (calibrated.translation - known.translation).norm();
+    comparison.known_translation_norm = known.translation.norm();
+    summary->known_rig_comparison.push_back(comparison);
+  }
+}
+
 bool WriteCalibrationSummaryJson(const std::string& path,
                                  const CalibrationSummary& summary,
                                  std::string* error) {
@@ -108,6 +138,22 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     cameras.push_back(node);
   }
   root["cameras"] = cameras;
+  if (summary.known_rig_source.empty()) {
+    root["known_rig"] = nullptr;
+  } else {
+    Json known = {{"source", summary.known_rig_source},
+                  {"reference_camera", summary.known_rig_reference_camera},
+                  {"cameras", Json::array()}};
+    for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
+      known["cameras"].push_back(
+          {{"name", comparison.camera},
+           {"rotation_error_deg", number(comparison.rotation_error_deg)},
+           {"translation_error", number(comparison.translation_error)},
+           {"known_translation_norm",
+            number(comparison.known_translation_norm)}});
+    }
+    root["known_rig"] = known;
+  }
   root["diagnostics"] = summary.diagnostics;
   Json timings = Json::object();
   for (const auto& [stage, seconds] : summary.timings_s) {

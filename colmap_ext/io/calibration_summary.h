@@ -31,6 +31,28 @@ struct CameraSummary {
   double rms_px = 0;
 };
 
+// Known cam_from_rig of the rig cameras, e.g. the sensor_from_rig of a
+// COLMAP >= 3.12 database's rig_sensors (set by rig_configurator), to compare
+// the calibration with.
+struct KnownRigPrior {
+  std::string source;  // e.g. "database calib.db, rig 2"
+  // The dataset index of the known rig's reference camera; -1: no prior.
+  int reference_camera = -1;
+  // Per dataset camera, cam_from_ref (the identity for the reference camera;
+  // unknown where not given).
+  std::vector<std::optional<Rigid3d>> cam_from_ref;
+};
+
+// The calibrated cam_from_ref of one camera against its KnownRigPrior.
+struct KnownPoseComparison {
+  std::string camera;
+  double rotation_error_deg = 0;
+  // |t_calibrated - t_known| in the map's units (the known translation is in
+  // the units rig_configurator was given, meters for a metric map).
+  double translation_error = 0;
+  double known_translation_norm = 0;
+};
+
 struct CalibrationSummary {
   // "1dr", "rd_ra", "rd", "known", "known_refine", "known_ra"
   std::string method;
@@ -41,6 +63,11 @@ struct CalibrationSummary {
   int num_framesets = 0;
   int num_framesets_used = 0;  // with a rig pose
   std::vector<CameraSummary> cameras;
+  // The comparison with a known rig (empty source: none), per camera with
+  // both a known and a calibrated pose, the reference camera excluded.
+  std::string known_rig_source;
+  std::string known_rig_reference_camera;
+  std::vector<KnownPoseComparison> known_rig_comparison;
   std::vector<std::string> diagnostics;  // warnings and notes, in order
   std::vector<std::pair<std::string, double>> timings_s;  // stage, seconds
 };
@@ -53,6 +80,11 @@ struct CalibrationSummary {
 CalibrationSummary SummarizeCalibration(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);
+
+// The calibration's cam_from_ref against `prior` (the reference: the
+// prior's): fills the known_rig_* fields. No-op without a prior.
+void CompareWithKnownRig(const KnownRigPrior& prior,
+                         CalibrationSummary* summary);
 
 bool WriteCalibrationSummaryJson(const std::string& path,
                                  const CalibrationSummary& summary,

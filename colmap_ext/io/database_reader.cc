@@ -11,6 +11,8 @@
 #include <set>
 #include <sstream>
 
+#include "colmap_ext/io/colmap_camera_models.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -18,12 +20,49 @@ namespace {
 // kMaxNumImages * min_id + max_id.
 constexpr uint64_t kMaxNumImages = 2147483647;
 
-// Tables that only databases of newer COLMAP versions have: rigs and frames
-// (3.12), pose_priors (3.10, when the prior_* columns left `images`).
-const char* const kNewerColmapTables[] = {"rigs", "frames", "pose_priors"};
 const char* const kColmap38Tables[] = {"cameras",   "images",
                                        "keypoints", "descriptors",
                                        "matches",   "two_view_geometries"};
+// The rig tables of COLMAP >= 3.12: all four or none.
+const char* const kRigTables[] = {"rigs", "rig_sensors", "frames",
+                                  "frame_data"};
+
+// COLMAP's sensor type of a camera in rig_sensors and frame_data.
+constexpr int kSensorTypeCamera = 0;
+
+// The `type` of COLMAP 4.x descriptors (src/colmap/feature/types.h).
+constexpr int kSiftDescriptorType = 0;
+std::string DescriptorTypeName(const int type) {
+  switch (type) {
+    case -1:
+      return "UNDEFINED (-1)";
+    case 0:
+      return "SIFT (0)";
+    case 1:
+      return "ALIKED_N16ROT (1)";
+    case 2:
+      return "ALIKED_N32 (2)";
+    default:
+      return "unknown type " + std::to_string(type);
+  }
+}
+
+// Column names of a table.
+std::set<std::string> TableColumns(sqlite3* database,
+                                   const std::string& table) {
+  std::set<std::string> columns;
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(database,
+                         ("PRAGMA table_info(" + table + ");").c_str(), -1,
+                         &statement, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(statement) == SQLITE_ROW) {
+      columns.insert(
+          reinterpret_cast<const char*>(sqlite3_column_text(statement, 1)));
+    }
+  }
+  sqlite3_finalize(statement);
+  return columns;
+}
 
 // Percent-encodes a file path for an SQLite "file:" URI (RFC 3986 unreserved
 // characters and '/' stay as they are).
@@ -164,6 +203,11 @@ void DatabaseReader::Close() {
     database_ = nullptr;
   }
   images_.clear();
+  rigs_.clear();
+  frames_.clear();
+  has_rigs_ = false;
+  descriptors_have_type_ = false;
+  images_have_priors_ = false;
   image_index_by_name_.clear();
   image_index_by_id_.clear();
   user_version_ = 0;
@@ -188,7 +232,8 @@ bool DatabaseReader::Open(const std::string& path, std::string* error) {
     Close();
     return false;
   }
-  if (!CheckSchema(error) || !ReadImages(error) || !PrepareStatements(error)) {
+  if (!CheckSchema(error) || !ReadImages(error) || !ReadRigsAndFrames(error) ||
+      !PrepareStatements(error)) {
     *error = prefix + *error;
     Close();
     return false;
@@ -209,7 +254,10 @@ bool DatabaseReader::PrepareStatements(std::string* error) {
       {&read_keypoints_,
        "SELECT rows, cols, data FROM keypoints WHERE image_id = ?;"},
       {&read_descriptors_,
-       "SELECT rows, cols, data FROM descriptors WHERE image_id = ?;"},
+       descriptors_have_type_
+           ? "SELECT rows, cols, data, type FROM descriptors WHERE image_id = "
+             "?;"
+           : "SELECT rows, cols, data FROM descriptors WHERE image_id = ?;"},
       {&read_inlier_matches_,
        "SELECT rows, cols, data FROM two_view_geometries WHERE pair_id = ?;"},
   };
@@ -246,38 +294,6 @@ bool DatabaseReader::CheckSchema(std::string* error) {
   }
   sqlite3_finalize(statement);
 
-  std::vector<std::string> newer_tables;
-  for (const char* table : kNewerColmapTables) {
-    if (tables.count(table) > 0) newer_tables.push_back(table);
-  }
-  bool images_has_priors = false;
-  if (tables.count("images") > 0 &&
-      sqlite3_prepare_v2(database_, "PRAGMA table_info(images);", -1,
-                         &statement, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(statement) == SQLITE_ROW) {
-      const char* column =
-          reinterpret_cast<const char*>(sqlite3_column_text(statement, 1));
-      images_has_priors |= std::strcmp(column, "prior_qw") == 0;
-    }
-    sqlite3_finalize(statement);
-  }
-  if (!newer_tables.empty() ||
-      (tables.count("images") > 0 && !images_has_priors)) {
-    std::ostringstream message;
-    message
-        << "written by a newer COLMAP than 3.8 (user_version " << user_version_
-        << "; "
-        << (newer_tables.empty()
-                ? std::string("the images table has no prior_* columns")
-                : "tables " + JoinNames(newer_tables))
-        << "). rig_calibrator is built on COLMAP 3.8, which cannot read "
-           "this schema: extract the features of the map and rig images "
-           "with COLMAP 3.8 into a new database and rebuild the map from it "
-           "(see README)";
-    *error = message.str();
-    return false;
-  }
-
   std::vector<std::string> missing;
   for (const char* table : kColmap38Tables) {
     if (tables.count(table) == 0) missing.push_back(table);
@@ -290,7 +306,7 @@ bool DatabaseReader::CheckSchema(std::string* error) {
     return false;
   }
   if (!missing.empty()) {
-    *error = "not a complete COLMAP 3.8 database: missing table(s) " +
+    *error = "not a complete COLMAP database: missing table(s) " +
              JoinNames(missing) +
              (tables.count("inlier_matches") > 0
                   ? " (it is from COLMAP older than 3.5; open a copy of it "
@@ -299,6 +315,170 @@ bool DatabaseReader::CheckSchema(std::string* error) {
                   : "");
     return false;
   }
+  std::vector<std::string> rig_tables;
+  std::vector<std::string> missing_rig_tables;
+  for (const char* table : kRigTables) {
+    (tables.count(table) > 0 ? rig_tables : missing_rig_tables)
+        .push_back(table);
+  }
+  if (!rig_tables.empty() && !missing_rig_tables.empty()) {
+    *error = "not a complete COLMAP >= 3.12 database: it has the table(s) " +
+             JoinNames(rig_tables) + " but not " +
+             JoinNames(missing_rig_tables);
+    return false;
+  }
+  has_rigs_ = !rig_tables.empty();
+  images_have_priors_ = TableColumns(database_, "images").count("prior_qw") > 0;
+  descriptors_have_type_ =
+      TableColumns(database_, "descriptors").count("type") > 0;
+  return CheckDescriptorTypes(error);
+}
+
+bool DatabaseReader::CheckDescriptorTypes(std::string* error) {
+  if (!descriptors_have_type_) return true;
+  // One row per image with descriptors: the scan reads each row's header,
+  // not its blob.
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT type, COUNT(*), MIN(image_id) FROM "
+                         "descriptors GROUP BY type ORDER BY type;",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    *error = std::string("cannot read the descriptors table: ") +
+             sqlite3_errmsg(database_);
+    return false;
+  }
+  std::string other_types;
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    const int type = sqlite3_column_int(statement, 0);
+    if (type == kSiftDescriptorType) continue;
+    other_types += (other_types.empty() ? "" : ", ") +
+                   DescriptorTypeName(type) + " for " +
+                   std::to_string(sqlite3_column_int64(statement, 1)) +
+                   " image(s), e.g. image id " +
+                   std::to_string(sqlite3_column_int64(statement, 2));
+  }
+  sqlite3_finalize(statement);
+  if (!other_types.empty()) {
+    *error = "the descriptors are not all SIFT: " + other_types +
+             ". rig_calibrator matches SIFT descriptors (type 0) only: "
+             "extract the features of the map and rig images with COLMAP's "
+             "SIFT extractor (the default of `colmap feature_extractor`)";
+    return false;
+  }
+  return true;
+}
+
+std::string DatabaseReader::SchemaDescription() const {
+  std::string version;
+  if (user_version_ >= 4000000) {
+    const int major = user_version_ / 1000000;
+    const int minor = user_version_ / 10000 % 100;
+    const int patch = user_version_ / 100 % 100;
+    version = "COLMAP " + std::to_string(major) + "." + std::to_string(minor) +
+              "." + std::to_string(patch);
+    if (user_version_ > 4019999) version += " (newer than 4.1, read as 4.1)";
+  } else if (user_version_ == 3900 || (user_version_ == 0 && has_rigs_)) {
+    version = "COLMAP 3.12 or 3.13";
+  } else if (images_have_priors_) {
+    version = "COLMAP 3.8 or older";
+  } else {
+    // pose_priors without rigs: 3.10 and 3.11.
+    version = "COLMAP 3.10 or 3.11";
+  }
+  return version + " schema (user_version " + std::to_string(user_version_) +
+         ")";
+}
+
+bool DatabaseReader::ReadRigsAndFrames(std::string* error) {
+  if (!has_rigs_) return true;
+  auto fail = [&](const std::string& table) {
+    *error =
+        "cannot read the " + table + " table: " + sqlite3_errmsg(database_);
+    return false;
+  };
+  std::unordered_map<uint32_t, size_t> rig_index;
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT rig_id, ref_sensor_id, ref_sensor_type FROM "
+                         "rigs ORDER BY rig_id;",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    return fail("rigs");
+  }
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    DatabaseRig rig;
+    rig.rig_id = static_cast<uint32_t>(sqlite3_column_int64(statement, 0));
+    if (sqlite3_column_int(statement, 2) == kSensorTypeCamera) {
+      rig.ref_camera_id =
+          static_cast<colmap::camera_t>(sqlite3_column_int64(statement, 1));
+    }
+    rig_index[rig.rig_id] = rigs_.size();
+    rigs_.push_back(rig);
+  }
+  sqlite3_finalize(statement);
+
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT rig_id, sensor_id, sensor_from_rig FROM "
+                         "rig_sensors WHERE sensor_type = 0 ORDER BY rig_id, "
+                         "sensor_id;",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    return fail("rig_sensors");
+  }
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    const uint32_t rig_id =
+        static_cast<uint32_t>(sqlite3_column_int64(statement, 0));
+    const auto rig = rig_index.find(rig_id);
+    if (rig == rig_index.end()) continue;  // COLMAP deletes them in cascade
+    DatabaseRig::Sensor sensor;
+    sensor.camera_id =
+        static_cast<colmap::camera_t>(sqlite3_column_int64(statement, 1));
+    // 7 doubles qw, qx, qy, qz, tx, ty, tz; NULL when unknown.
+    if (sqlite3_column_type(statement, 2) != SQLITE_NULL) {
+      if (sqlite3_column_bytes(statement, 2) != 7 * sizeof(double)) {
+        sqlite3_finalize(statement);
+        *error = "rig_sensors: the sensor_from_rig of camera " +
+                 std::to_string(sensor.camera_id) + " in rig " +
+                 std::to_string(rig_id) + " is not 7 doubles";
+        return false;
+      }
+      double v[7];
+      std::memcpy(v, sqlite3_column_blob(statement, 2), sizeof(v));
+      sensor.sensor_from_rig =
+          Rigid3d(Eigen::Quaterniond(v[0], v[1], v[2], v[3]).normalized(),
+                  Eigen::Vector3d(v[4], v[5], v[6]));
+    }
+    rigs_[rig->second].cameras.push_back(sensor);
+  }
+  sqlite3_finalize(statement);
+
+  std::unordered_map<uint32_t, size_t> frame_index;
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT frame_id, rig_id FROM frames ORDER BY "
+                         "frame_id;",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    return fail("frames");
+  }
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    DatabaseFrame frame;
+    frame.frame_id = static_cast<uint32_t>(sqlite3_column_int64(statement, 0));
+    frame.rig_id = static_cast<uint32_t>(sqlite3_column_int64(statement, 1));
+    frame_index[frame.frame_id] = frames_.size();
+    frames_.push_back(frame);
+  }
+  sqlite3_finalize(statement);
+  if (sqlite3_prepare_v2(database_,
+                         "SELECT frame_id, data_id FROM frame_data WHERE "
+                         "sensor_type = 0 ORDER BY frame_id, data_id;",
+                         -1, &statement, nullptr) != SQLITE_OK) {
+    return fail("frame_data");
+  }
+  while (sqlite3_step(statement) == SQLITE_ROW) {
+    const auto frame = frame_index.find(
+        static_cast<uint32_t>(sqlite3_column_int64(statement, 0)));
+    if (frame == frame_index.end()) continue;
+    frames_[frame->second].image_ids.push_back(
+        static_cast<colmap::image_t>(sqlite3_column_int64(statement, 1)));
+  }
+  sqlite3_finalize(statement);
   return true;
 }
 
@@ -347,7 +527,7 @@ const DatabaseImage* DatabaseReader::FindImageWithId(
 }
 
 bool DatabaseReader::ReadCamera(const colmap::camera_t camera_id,
-                                colmap::Camera* camera,
+                                DatabaseCamera* camera,
                                 std::string* error) const {
   std::lock_guard<std::mutex> lock(mutex_);
   StatementScope scope(read_camera_);
@@ -357,29 +537,59 @@ bool DatabaseReader::ReadCamera(const colmap::camera_t camera_id,
              std::to_string(camera_id);
     return false;
   }
-  const int model_id = sqlite3_column_int(read_camera_, 0);
-  if (!colmap::ExistsCameraModelWithId(model_id)) {
-    *error = "database " + path_ + ": camera " + std::to_string(camera_id) +
-             " has model id " + std::to_string(model_id) +
-             ", which COLMAP 3.8 does not know";
-    return false;
-  }
-  const size_t num_params = colmap::CameraModelNumParams(model_id);
+  *camera = DatabaseCamera();
+  camera->camera_id = camera_id;
+  camera->model_id = sqlite3_column_int(read_camera_, 0);
+  camera->model_name = ColmapCameraModelName(camera->model_id);
+  camera->known_to_colmap38 = colmap::ExistsCameraModelWithId(camera->model_id);
+  camera->width = static_cast<size_t>(sqlite3_column_int64(read_camera_, 1));
+  camera->height = static_cast<size_t>(sqlite3_column_int64(read_camera_, 2));
+  camera->prior_focal_length = sqlite3_column_int(read_camera_, 4) != 0;
   const int num_bytes = sqlite3_column_bytes(read_camera_, 3);
-  if (static_cast<size_t>(num_bytes) != num_params * sizeof(double)) {
+  const int num_params = ColmapCameraModelNumParams(camera->model_id);
+  if (num_params >= 0 &&
+      static_cast<size_t>(num_bytes) != num_params * sizeof(double)) {
     *error = "database " + path_ + ": camera " + std::to_string(camera_id) +
              " has " + std::to_string(num_bytes / sizeof(double)) +
-             " parameters, its model needs " + std::to_string(num_params);
+             " parameters, its model " + camera->model_name + " needs " +
+             std::to_string(num_params);
     return false;
   }
-  std::vector<double> params(num_params);
-  std::memcpy(params.data(), sqlite3_column_blob(read_camera_, 3), num_bytes);
-  camera->SetCameraId(camera_id);
-  camera->SetModelId(model_id);
-  camera->SetWidth(static_cast<size_t>(sqlite3_column_int64(read_camera_, 1)));
-  camera->SetHeight(static_cast<size_t>(sqlite3_column_int64(read_camera_, 2)));
-  camera->SetParams(params);
-  camera->SetPriorFocalLength(sqlite3_column_int(read_camera_, 4) != 0);
+  camera->params.resize(num_bytes / sizeof(double));
+  if (!camera->params.empty()) {
+    std::memcpy(camera->params.data(), sqlite3_column_blob(read_camera_, 3),
+                camera->params.size() * sizeof(double));
+  }
+  return true;
+}
+
+bool DatabaseReader::ReadCamera(const colmap::camera_t camera_id,
+                                colmap::Camera* camera,
+                                std::string* error) const {
+  DatabaseCamera database_camera;
+  if (!ReadCamera(camera_id, &database_camera, error)) return false;
+  if (!ToColmapCamera(database_camera, camera, error)) {
+    *error = "database " + path_ + ": " + *error;
+    return false;
+  }
+  return true;
+}
+
+bool ToColmapCamera(const DatabaseCamera& database_camera,
+                    colmap::Camera* camera, std::string* error) {
+  if (!database_camera.known_to_colmap38) {
+    *error = "camera " + std::to_string(database_camera.camera_id) +
+             " has the model " +
+             DescribeColmapCameraModel(database_camera.model_id) +
+             ", which COLMAP 3.8 (this build) does not know";
+    return false;
+  }
+  camera->SetCameraId(database_camera.camera_id);
+  camera->SetModelId(database_camera.model_id);
+  camera->SetWidth(database_camera.width);
+  camera->SetHeight(database_camera.height);
+  camera->SetParams(database_camera.params);
+  camera->SetPriorFocalLength(database_camera.prior_focal_length);
   return true;
 }
 
@@ -449,6 +659,15 @@ bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
       "database " + path_ + ": descriptors of " + ImageLabel(image_id);
   BlobMatrix blob;
   if (!StepFeatureRow(read_descriptors_, image_id, what, &blob, error)) {
+    return false;
+  }
+  // Open checks the whole table; this keeps any other type (whose floats
+  // would pass for bytes) out of the matcher.
+  if (descriptors_have_type_ &&
+      sqlite3_column_int(read_descriptors_, 3) != kSiftDescriptorType) {
+    *error = what + " are of type " +
+             DescriptorTypeName(sqlite3_column_int(read_descriptors_, 3)) +
+             "; rig_calibrator matches SIFT descriptors (type 0) only";
     return false;
   }
   if (blob.rows > 0 && blob.cols != 128) {

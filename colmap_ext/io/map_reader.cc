@@ -8,6 +8,12 @@
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <optional>
+#include <unordered_map>
+
+#include "colmap_ext/io/colmap_camera_models.h"
+#include "colmap_ext/io/rigs_frames_io.h"
 
 namespace rig_calibrator {
 namespace {
@@ -68,8 +74,7 @@ class BinaryWalker {
   }
 
   bool Fail(const std::string& message) {
-    *error_ = file_.string() +
-              " is not a COLMAP binary model file (of COLMAP 3.8): " + message;
+    *error_ = file_.string() + " is not a COLMAP binary model file: " + message;
     return false;
   }
 
@@ -99,29 +104,7 @@ bool CheckBinaryRecords(const fs::path& file, const char* count_what,
   return walker.CheckEnd();
 }
 
-// Record layouts of COLMAP 3.8's Reconstruction::Write*Binary.
-bool CheckCamerasBinary(const fs::path& file, std::string* error) {
-  return CheckBinaryRecords(
-      file, "the camera count",
-      [](BinaryWalker* walker) {
-        uint32_t camera_id = 0;
-        int32_t model_id = 0;
-        if (!walker->Read(&camera_id, "a camera id") ||
-            !walker->Read(&model_id, "a camera model id")) {
-          return false;
-        }
-        if (!colmap::ExistsCameraModelWithId(model_id)) {
-          return walker->Fail("camera " + std::to_string(camera_id) +
-                              " has the model id " + std::to_string(model_id) +
-                              ", which COLMAP 3.8 does not know");
-        }
-        return walker->Skip(2, sizeof(uint64_t), "a camera size") &&
-               walker->Skip(colmap::CameraModelNumParams(model_id),
-                            sizeof(double), "camera parameters");
-      },
-      error);
-}
-
+// Record layouts of COLMAP's Reconstruction::Write*Binary (3.8 to 4.1).
 bool CheckImagesBinary(const fs::path& file, std::string* error) {
   return CheckBinaryRecords(
       file, "the image count",
@@ -150,37 +133,6 @@ bool CheckPoints3DBinary(const fs::path& file, std::string* error) {
                             "a point's track");
       },
       error);
-}
-
-// COLMAP 3.8's text reader aborts on an unknown model name or a wrong number
-// of parameters; everything else it cannot parse throws.
-bool CheckCamerasText(const fs::path& file, std::string* error) {
-  std::ifstream stream(file.string());
-  std::string line;
-  for (int line_number = 1; std::getline(stream, line); ++line_number) {
-    boost::trim(line);
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> items;
-    boost::split(items, line, boost::is_any_of(" "));
-    const std::string where =
-        file.string() + " line " + std::to_string(line_number) + ": ";
-    if (items.size() < 4 || !colmap::ExistsCameraModelWithName(items[1])) {
-      *error = where +
-               "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS[] with a COLMAP "
-               "3.8 camera model, found '" +
-               line.substr(0, 80) + "'";
-      return false;
-    }
-    const size_t num_params =
-        colmap::CameraModelNumParams(colmap::CameraModelNameToId(items[1]));
-    if (items.size() - 4 != num_params) {
-      *error = where + "the model " + items[1] + " has " +
-               std::to_string(num_params) + " parameters, the line gives " +
-               std::to_string(items.size() - 4);
-      return false;
-    }
-  }
-  return true;
 }
 
 // References between cameras, images and points that the rest of the
@@ -217,10 +169,231 @@ bool CheckReferences(const std::string& path, const colmap::Reconstruction& map,
   return true;
 }
 
+// A folder under the system's temporary folder, removed with its contents
+// when the object goes out of scope.
+class TemporaryFolder {
+ public:
+  TemporaryFolder() {
+    boost::system::error_code fs_error;
+    path_ = fs::temp_directory_path(fs_error) /
+            fs::unique_path("rig_calibrator_map_%%%%-%%%%-%%%%");
+    created_ = fs::create_directories(path_, fs_error);
+  }
+  ~TemporaryFolder() {
+    boost::system::error_code ignored;
+    if (created_) fs::remove_all(path_, ignored);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  bool created() const { return created_; }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+  bool created_ = false;
+};
+
+// The placeholder of a camera of a model COLMAP 3.8 does not know.
+CameraRecord PlaceholderCamera(const CameraRecord& camera) {
+  CameraRecord placeholder = camera;
+  placeholder.model_id = colmap::PinholeCameraModel::model_id;
+  const double focal =
+      1.2 * static_cast<double>(std::max(camera.width, camera.height));
+  placeholder.params = {focal, focal, 0.5 * camera.width, 0.5 * camera.height};
+  return placeholder;
+}
+
+// Reads the model with COLMAP 3.8's reader, from a temporary folder with
+// placeholder cameras (and links to the other files) if some cameras have
+// models it does not know.
+bool ReadWithColmap(const fs::path& folder, const bool binary,
+                    const std::vector<CameraRecord>& cameras,
+                    colmap::Reconstruction* map, MapReadInfo* info,
+                    std::string* error) {
+  std::vector<CameraRecord> readable = cameras;
+  for (CameraRecord& camera : readable) {
+    if (!colmap::ExistsCameraModelWithId(camera.model_id)) {
+      info->newer_model_cameras.push_back(camera);
+      camera = PlaceholderCamera(camera);
+    }
+  }
+  const std::string extension = binary ? ".bin" : ".txt";
+  std::optional<TemporaryFolder> temporary;
+  fs::path read_folder = folder;
+  if (!info->newer_model_cameras.empty()) {
+    boost::system::error_code fs_error;
+    temporary.emplace();
+    if (!temporary->created()) {
+      *error = "cannot create a temporary folder to read the map in " +
+               folder.string();
+      return false;
+    }
+    for (const std::string name : {"images", "points3D"}) {
+      fs::create_symlink(fs::absolute(folder / (name + extension)),
+                         temporary->path() / (name + extension), fs_error);
+      if (fs_error) {
+        *error = "cannot link " + (folder / (name + extension)).string() +
+                 " into a temporary folder: " + fs_error.message();
+        return false;
+      }
+    }
+    if (!WriteCameraRecords(
+            (temporary->path() / ("cameras" + extension)).string(), binary,
+            readable, error)) {
+      return false;
+    }
+    read_folder = temporary->path();
+    std::string list;
+    for (const CameraRecord& camera : info->newer_model_cameras) {
+      list += (list.empty() ? "" : ", ") + std::to_string(camera.camera_id) +
+              " " + DescribeColmapCameraModel(camera.model_id);
+    }
+    info->notes.push_back(
+        "map camera(s) of models COLMAP 3.8 does not know: " + list +
+        "; held as placeholders (localization does not use the map's "
+        "intrinsics) and written back unchanged into the output model");
+  }
+  try {
+    if (binary) {
+      map->ReadBinary(read_folder.string());
+    } else {
+      map->ReadText(read_folder.string());
+    }
+  } catch (const std::exception& exception) {
+    *error = "cannot read the map in " + folder.string() +
+             " (not a COLMAP text model?): " + exception.what();
+    return false;
+  }
+  return true;
+}
+
+// Checks the rigs and frames against the images (see map_reader.h) and
+// summarizes them in `info`.
+bool CheckRigsAndFrames(const std::string& path,
+                        const colmap::Reconstruction& map,
+                        const ColmapRigsAndFrames& rigs_frames,
+                        MapReadInfo* info, std::string* error) {
+  const std::string prefix = "the map in " + path + ": ";
+  // sensor_from_rig of every camera sensor, by rig; the reference camera's
+  // is the identity.
+  std::map<uint32_t, std::unordered_map<uint32_t, std::optional<Rigid3d>>>
+      camera_from_rig;
+  for (const ColmapRig& rig : rigs_frames.rigs) {
+    auto& cameras = camera_from_rig[rig.rig_id];
+    int num_cameras = 0;
+    if (rig.ref_sensor.type == kSensorCamera) {
+      cameras[rig.ref_sensor.id] = Rigid3d();
+      ++num_cameras;
+    }
+    for (const ColmapRigSensor& sensor : rig.sensors) {
+      if (sensor.sensor.type != kSensorCamera) continue;
+      cameras[sensor.sensor.id] = sensor.sensor_from_rig;
+      ++num_cameras;
+    }
+    info->num_multi_camera_rigs += num_cameras > 1 ? 1 : 0;
+  }
+  std::unordered_map<colmap::image_t, int> num_frames_of_image;
+  for (const ColmapFrame& frame : rigs_frames.frames) {
+    const auto rig = camera_from_rig.find(frame.rig_id);
+    if (rig == camera_from_rig.end()) {
+      *error = prefix + "frame " + std::to_string(frame.frame_id) +
+               " refers to rig " + std::to_string(frame.rig_id) +
+               ", which is not in the rigs file";
+      return false;
+    }
+    for (const ColmapFrameData& data : frame.data) {
+      if (data.sensor.type != kSensorCamera) continue;
+      const colmap::image_t image_id =
+          static_cast<colmap::image_t>(data.data_id);
+      ++num_frames_of_image[image_id];
+      const auto sensor = rig->second.find(data.sensor.id);
+      if (!map.ExistsImage(image_id) || sensor == rig->second.end() ||
+          map.Image(image_id).CameraId() != data.sensor.id) {
+        *error = prefix + "frame " + std::to_string(frame.frame_id) +
+                 " holds image " + std::to_string(image_id) + " of camera " +
+                 std::to_string(data.sensor.id) +
+                 ", which is not an image of that camera of the model or not "
+                 "a camera of rig " +
+                 std::to_string(frame.rig_id);
+        return false;
+      }
+      if (!sensor->second) continue;
+      const colmap::Image& image = map.Image(image_id);
+      const Rigid3d expected = *sensor->second * frame.rig_from_world;
+      const Rigid3d stored = Rigid3d::FromQvecTvec(image.Qvec(), image.Tvec());
+      if ((expected.RotationMatrix() - stored.RotationMatrix()).norm() > 1e-6 ||
+          (expected.translation - stored.translation).norm() >
+              1e-6 * std::max(1.0, expected.translation.norm())) {
+        *error = prefix + "the pose of image " + image.Name() +
+                 " differs from sensor_from_rig * rig_from_world of frame " +
+                 std::to_string(frame.frame_id) +
+                 ": the rigs/frames files do not belong to this model";
+        return false;
+      }
+    }
+  }
+  for (const colmap::image_t image_id : map.RegImageIds()) {
+    const auto count = num_frames_of_image.find(image_id);
+    if (count == num_frames_of_image.end() || count->second != 1) {
+      *error = prefix + "the image " + map.Image(image_id).Name() + " is in " +
+               std::to_string(
+                   count == num_frames_of_image.end() ? 0 : count->second) +
+               " frames; COLMAP >= 3.12 needs every registered image in one "
+               "frame";
+      return false;
+    }
+  }
+  info->has_rigs_frames = true;
+  info->num_rigs = static_cast<int>(rigs_frames.rigs.size());
+  info->num_frames = static_cast<int>(rigs_frames.frames.size());
+  info->notes.push_back(
+      "rigs and frames (COLMAP >= 3.12): " + std::to_string(info->num_rigs) +
+      " rig(s), " + std::to_string(info->num_multi_camera_rigs) +
+      " with several cameras, " + std::to_string(info->num_frames) +
+      " frame(s); every image's pose equals sensor_from_rig * rig_from_world "
+      "of its frame, so the image poses are used as they are");
+  return true;
+}
+
+// The rigs and frames files of the model's type: both or none.
+bool ReadMapRigsAndFrames(const std::string& path, const bool binary,
+                          const colmap::Reconstruction& map, MapReadInfo* info,
+                          std::string* error) {
+  const fs::path folder(path);
+  const std::string extension = binary ? ".bin" : ".txt";
+  const bool has_rigs = fs::exists(folder / ("rigs" + extension));
+  const bool has_frames = fs::exists(folder / ("frames" + extension));
+  if (!has_rigs && !has_frames) return true;
+  if (has_rigs != has_frames) {
+    *error = "the map folder " + path + " has " +
+             (has_rigs ? "rigs" : "frames") + extension + " but no " +
+             (has_rigs ? "frames" : "rigs") + extension +
+             " (COLMAP >= 3.12 writes both)";
+    return false;
+  }
+  ColmapRigsAndFrames rigs_frames;
+  std::string read_error;
+  // ReadRigsAndFrames reads the .bin files if both are there, else the .txt
+  // ones, as COLMAP does.
+  if (!ReadRigsAndFrames(path, &rigs_frames, &read_error)) {
+    *error = "cannot read the rigs and frames of the map in " + path + ": " +
+             read_error;
+    return false;
+  }
+  return CheckRigsAndFrames(path, map, rigs_frames, info, error);
+}
+
 }  // namespace
 
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              std::string* error) {
+  MapReadInfo info;
+  return ReadMap(path, map, &info, error);
+}
+
+bool ReadMap(const std::string& path, colmap::Reconstruction* map,
+             MapReadInfo* info, std::string* error) {
+  *info = MapReadInfo();
   const fs::path folder(path);
   if (!fs::is_directory(folder)) {
     *error = "the map folder " + path +
@@ -245,24 +418,21 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
       return false;
     }
   }
-  const bool checked =
-      binary ? CheckCamerasBinary(folder / "cameras.bin", error) &&
-                   CheckImagesBinary(folder / "images.bin", error) &&
-                   CheckPoints3DBinary(folder / "points3D.bin", error)
-             : CheckCamerasText(folder / "cameras.txt", error);
-  if (!checked) return false;
-  try {
-    if (binary) {
-      map->ReadBinary(path);
-    } else {
-      map->ReadText(path);
-    }
-  } catch (const std::exception& exception) {
-    *error = "cannot read the map in " + path +
-             " (not a COLMAP 3.8 text model?): " + exception.what();
+  std::vector<CameraRecord> cameras;
+  if (!ReadCameraRecords(
+          (folder / (binary ? "cameras.bin" : "cameras.txt")).string(), binary,
+          &cameras, error)) {
     return false;
   }
-  if (!CheckReferences(path, *map, error)) return false;
+  if (binary && (!CheckImagesBinary(folder / "images.bin", error) ||
+                 !CheckPoints3DBinary(folder / "points3D.bin", error))) {
+    return false;
+  }
+  if (!ReadWithColmap(folder, binary, cameras, map, info, error) ||
+      !CheckReferences(path, *map, error) ||
+      !ReadMapRigsAndFrames(path, binary, *map, info, error)) {
+    return false;
+  }
   if (map->NumRegImages() == 0) {
     *error = "the map in " + path + " has no registered image";
     return false;
@@ -274,6 +444,21 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
     return false;
   }
   return true;
+}
+
+bool RestoreNewerModelCameras(const std::string& folder, const bool binary,
+                              const std::vector<CameraRecord>& cameras,
+                              std::string* error) {
+  if (cameras.empty()) return true;
+  const std::string path = folder + (binary ? "/cameras.bin" : "/cameras.txt");
+  std::vector<CameraRecord> written;
+  if (!ReadCameraRecords(path, binary, &written, error)) return false;
+  for (CameraRecord& record : written) {
+    for (const CameraRecord& camera : cameras) {
+      if (camera.camera_id == record.camera_id) record = camera;
+    }
+  }
+  return WriteCameraRecords(path, binary, written, error);
 }
 
 colmap::camera_t MaxCameraId(const colmap::Reconstruction& model) {

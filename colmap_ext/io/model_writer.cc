@@ -311,6 +311,7 @@ struct RigOutputContents {
   RigDescription rig;
   bool reference_calibrated = false;
   std::vector<std::string> notes;
+  std::vector<CameraRecord> newer_model_map_cameras;
 };
 
 bool BuildRigOutputContents(const colmap::Reconstruction& map,
@@ -327,6 +328,7 @@ bool BuildRigOutputContents(const colmap::Reconstruction& map,
     return false;
   }
   contents->binary = output_type == "BIN";
+  contents->newer_model_map_cameras = options.newer_model_map_cameras;
   if (!camera_prefixes.empty() &&
       camera_prefixes.size() != dataset.cameras.size()) {
     *error = "one camera prefix per camera is needed";
@@ -364,6 +366,10 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
   }
   if (!ModelFilesExist(folder, binary ? ".bin" : ".txt")) {
     *error = "cannot write the COLMAP model into " + folder;
+    return false;
+  }
+  if (!RestoreNewerModelCameras(folder, binary,
+                                contents->newer_model_map_cameras, error)) {
     return false;
   }
   const RigDescription& rig = contents->rig;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "colmap_ext/io/calibration_summary.h"
+#include "colmap_ext/io/camera_records_io.h"
 #include "colmap_ext/io/rigs_frames_io.h"
 #include "src/calibration/rig_dataset.h"
 
@@ -61,6 +62,9 @@ struct RigOutputOptions {
   // The run's inputs (database, image path, map, correspondence file): the
   // output folder must not overlap any of them.
   std::vector<std::string> input_paths;
+  // Map cameras of models COLMAP 3.8 does not know (MapReadInfo), written in
+  // place of their placeholders.
+  std::vector<CameraRecord> newer_model_map_cameras;
 };
 
 // Builds the model (BuildRigModel) and writes every file above into

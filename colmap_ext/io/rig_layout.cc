@@ -232,6 +232,48 @@ bool AssignCameras(const std::vector<std::string>& image_names,
   return true;
 }
 
+// The given frames as framesets (an image without a frame alone), in
+// natural order of their first image's key; fails for a frame with two
+// images of one camera.
+bool GroupGivenFrames(const std::vector<std::string>& image_names,
+                      const std::vector<std::string>& keys,
+                      const RigLayoutOptions& options, const RigLayout& layout,
+                      std::vector<std::vector<int>>* framesets,
+                      std::string* error) {
+  if (options.frame_ids.size() != image_names.size()) {
+    *error = "one frame id per image name is needed";
+    return false;
+  }
+  std::map<int64_t, std::vector<int>> frame_images;
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    if (layout.images[i].camera_index < 0) continue;
+    if (options.frame_ids[i] < 0) {
+      framesets->push_back({static_cast<int>(i)});
+      continue;
+    }
+    std::vector<int>& images = frame_images[options.frame_ids[i]];
+    for (const int other : images) {
+      if (layout.images[other].camera_index == layout.images[i].camera_index) {
+        *error = "frame " + std::to_string(options.frame_ids[i]) + " of " +
+                 options.frame_source + " holds two images of camera " +
+                 layout.camera_prefixes[layout.images[i].camera_index] + " (" +
+                 image_names[other] + ", " + image_names[i] +
+                 "): give camera prefixes that match the cameras of the "
+                 "frames";
+        return false;
+      }
+    }
+    images.push_back(static_cast<int>(i));
+  }
+  for (auto& entry : frame_images)
+    framesets->push_back(std::move(entry.second));
+  std::sort(framesets->begin(), framesets->end(),
+            [&](const std::vector<int>& a, const std::vector<int>& b) {
+              return NaturalLess(keys[a.front()], keys[b.front()]);
+            });
+  return true;
+}
+
 // The framesets, each a list of input indices: the images with the same key,
 // or (timestamp_tolerance > 0) the clusters of close timestamps per folder.
 bool GroupFramesets(const std::vector<std::string>& image_names,
@@ -239,6 +281,10 @@ bool GroupFramesets(const std::vector<std::string>& image_names,
                     const RigLayoutOptions& options, const RigLayout& layout,
                     std::vector<std::vector<int>>* framesets,
                     std::string* error) {
+  if (!options.frame_ids.empty()) {
+    return GroupGivenFrames(image_names, keys, options, layout, framesets,
+                            error);
+  }
   if (options.timestamp_tolerance > 0) {
     std::vector<TimedKey> timed_keys(image_names.size());
     std::map<std::string, std::vector<int>> folder_images;
@@ -371,6 +417,16 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
     return false;
   }
   NameFramesets(keys, framesets, layout);
+  if (!options.frame_ids.empty()) {
+    layout->frameset_source = options.frame_source;
+  } else if (options.timestamp_tolerance > 0) {
+    std::ostringstream source;
+    source << "numeric names (timestamps) within "
+           << options.timestamp_tolerance;
+    layout->frameset_source = source.str();
+  } else {
+    layout->frameset_source = "identical names after the camera prefix";
+  }
   if (!CheckCamerasConnected(*layout, error)) {
     *layout = RigLayout();
     return false;
@@ -401,7 +457,8 @@ std::string RigLayoutTable(const std::vector<std::string>& image_names,
 
   std::ostringstream table;
   table << "Rig layout: " << num_cameras << " cameras, "
-        << layout.frameset_names.size() << " framesets\n";
+        << layout.frameset_names.size() << " framesets (from "
+        << layout.frameset_source << ")\n";
   auto pad = [](const std::string& text, size_t width) {
     return text +
            std::string(width > text.size() ? width - text.size() : 0, ' ');

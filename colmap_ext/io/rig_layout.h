@@ -7,9 +7,11 @@
 // after the camera prefix: identical keys form a frameset (COLMAP's
 // convention: cam0/000012.png and cam1/000012.png), or, when the keys are
 // numbers such as nanosecond timestamps (EuRoC: 1403715273262142976.png),
-// keys within a tolerance do.
+// keys within a tolerance do. Or the framesets are given: the frames of a
+// COLMAP >= 3.12 database after COLMAP's rig_configurator grouped its images.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,6 +27,14 @@ struct RigLayoutOptions {
   // numbers are within this tolerance (in the names' units, e.g. nanoseconds)
   // form a frameset, at most one image per camera.
   double timestamp_tolerance = 0;
+  // Empty, or one per image name: the id of the frame the image is in (e.g.
+  // COLMAP's frames/frame_data), -1 for none. Given, the framesets are these
+  // frames (an image without one is alone) and timestamp_tolerance is not
+  // used.
+  std::vector<int64_t> frame_ids;
+  // How the given frames are named in the rig table, e.g. "the database's
+  // frames (COLMAP rig_configurator)".
+  std::string frame_source;
 };
 
 struct RigLayoutImage {
@@ -47,18 +57,23 @@ struct RigLayout {
   // Indices of input names alone in their frameset: they constrain their
   // camera's intrinsics but not the rig.
   std::vector<int> unmatched_images;
+  // Where the framesets come from, for the rig table: "identical names after
+  // the camera prefix", "timestamps within ...", or the given frame_source.
+  std::string frameset_source;
 };
 
 // Discovers the cameras and framesets of `image_names` (the rig images only,
 // not the map's). Fails with a message in `error` when there are no camera
 // folders, fewer than two cameras, a given prefix matches no image, numeric
-// keys are expected but a name is not a number, or some cameras never share
-// a frameset (directly or through other cameras) with the others.
+// keys are expected but a name is not a number, a given frame holds two
+// images of one camera, or some cameras never share a frameset (directly or
+// through other cameras) with the others.
 bool DiscoverRigLayout(const std::vector<std::string>& image_names,
                        const RigLayoutOptions& options, RigLayout* layout,
                        std::string* error);
 
-// A table for the log: per camera the number of images, of images in
+// A table for the log, headed by where the framesets come from: per camera
+// the number of images, of images in
 // framesets with other cameras and of unmatched images; the number of
 // framesets with k cameras; the first unmatched and ignored names.
 std::string RigLayoutTable(const std::vector<std::string>& image_names,

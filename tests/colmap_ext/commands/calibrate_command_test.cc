@@ -18,6 +18,7 @@
 
 #include "colmap_ext/commands/commands.h"
 #include "tests/colmap_ext/colmap_testing.h"
+#include "tests/colmap_ext/modern_database.h"
 #include "tests/testing.h"
 
 namespace rig_calibrator {
@@ -324,44 +325,59 @@ TEST_F(CalibrateCommandBadInput, NonColmapFilesAsDatabase) {
                "database"});
 }
 
-TEST_F(CalibrateCommandBadInput, DatabaseOfNewerColmap) {
-  // The schema of COLMAP >= 3.12: rigs and frames tables, pose priors out of
-  // the images table.
-  const std::string newer = inputs_ + "/colmap312.db";
-  ExecuteSql(newer,
-             "CREATE TABLE rigs (rig_id INTEGER PRIMARY KEY NOT NULL, "
-             "ref_sensor_id INTEGER NOT NULL, ref_sensor_type INTEGER NOT "
-             "NULL);"
-             "CREATE TABLE rig_sensors (rig_id INTEGER NOT NULL, sensor_id "
-             "INTEGER NOT NULL, sensor_type INTEGER NOT NULL, sensor_from_rig "
-             "BLOB);"
-             "CREATE TABLE cameras (camera_id INTEGER PRIMARY KEY NOT NULL, "
-             "model INTEGER NOT NULL, width INTEGER NOT NULL, height INTEGER "
-             "NOT NULL, params BLOB, prior_focal_length INTEGER NOT NULL);"
-             "CREATE TABLE frames (frame_id INTEGER PRIMARY KEY NOT NULL, "
-             "rig_id INTEGER NOT NULL);"
-             "CREATE TABLE frame_data (frame_id INTEGER NOT NULL, data_id "
-             "INTEGER NOT NULL, sensor_id INTEGER NOT NULL, sensor_type "
-             "INTEGER NOT NULL);"
-             "CREATE TABLE images (image_id INTEGER PRIMARY KEY NOT NULL, name "
-             "TEXT NOT NULL UNIQUE, camera_id INTEGER NOT NULL);"
-             "CREATE TABLE pose_priors (image_id INTEGER PRIMARY KEY NOT NULL, "
-             "position BLOB, coordinate_system INTEGER NOT NULL, "
-             "position_covariance BLOB);"
-             "CREATE TABLE keypoints (image_id INTEGER PRIMARY KEY NOT NULL, "
-             "rows INTEGER NOT NULL, cols INTEGER NOT NULL, data BLOB);"
-             "CREATE TABLE descriptors (image_id INTEGER PRIMARY KEY NOT "
-             "NULL, rows INTEGER NOT NULL, cols INTEGER NOT NULL, data BLOB);"
-             "CREATE TABLE matches (pair_id INTEGER PRIMARY KEY NOT NULL, "
-             "rows INTEGER NOT NULL, cols INTEGER NOT NULL, data BLOB);"
-             "CREATE TABLE two_view_geometries (pair_id INTEGER PRIMARY KEY "
-             "NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT NULL, data "
-             "BLOB, config INTEGER NOT NULL, F BLOB, E BLOB, H BLOB, qvec "
-             "BLOB, tvec BLOB);"
-             "INSERT INTO images VALUES (1, 'cam0/0001.png', 1);");
-  ExpectFails(With(Arguments(), "--database_path", newer),
-              {"database " + newer + ": written by a newer COLMAP than 3.8",
-               "rigs, frames, pose_priors"});
+// A COLMAP 4.1 database (written following its schema) of the map and rig
+// images, with descriptors of `descriptor_type` and the camera of cam0 of
+// model `cam0_model_id` (a known focal length).
+void WriteColmap41Database(const std::string& path, const int descriptor_type,
+                           const int cam0_model_id,
+                           const std::vector<double>& cam0_params) {
+  testing::ModernDatabase database(path, testing::ColmapSchema::k4_1);
+  const uint32_t map_camera =
+      database.AddCamera(2, 640, 480, {500, 320, 240, 0}, false);
+  const uint32_t cam0 =
+      database.AddCamera(cam0_model_id, 640, 480, cam0_params, true);
+  const uint32_t cam1 =
+      database.AddCamera(4, 640, 480, {480, 480, 320, 240, 0, 0, 0, 0}, false);
+  for (const std::string name :
+       {"map/0.png", "map/1.png", "map/2.png", "cam0/0001.png", "cam0/0002.png",
+        "cam1/0001.png", "cam1/0002.png"}) {
+    const uint32_t camera = name[0] == 'm'   ? map_camera
+                            : name[3] == '0' ? cam0
+                                             : cam1;
+    const uint32_t image_id = database.AddImage(name, camera);
+    database.AddKeypoints(image_id, 6, std::vector<float>(6 * 4, 1.0f));
+    if (descriptor_type == 0) {
+      database.AddSiftDescriptors(image_id, std::vector<uint8_t>(4 * 128, 3));
+    } else {
+      database.AddFloatDescriptors(image_id, descriptor_type, 128,
+                                   std::vector<float>(4 * 128, 0.5f));
+    }
+  }
+}
+
+TEST_F(CalibrateCommandBadInput, DatabaseOfNonSiftDescriptors) {
+  const std::string aliked = inputs_ + "/aliked.db";
+  WriteColmap41Database(aliked, 2, 4, {400, 400, 320, 240, 0, 0, 0, 0});
+  ExpectFails(With(Arguments(), "--database_path", aliked),
+              {"database " + aliked + ": the descriptors are not all SIFT: " +
+                   "ALIKED_N32 (2) for 7 image(s)",
+               "SIFT descriptors (type 0) only"});
+}
+
+TEST_F(CalibrateCommandBadInput, RigCameraOfAModelThisBuildCannotUse) {
+  // FISHEYE (COLMAP 4.0): fine for its image size, but not as the known
+  // intrinsics of method known.
+  const std::string fisheye = inputs_ + "/fisheye.db";
+  WriteColmap41Database(fisheye, 0, 15, {400, 400, 320, 240});
+  ExpectFails(With(With(Arguments(), "--database_path", fisheye),
+                   "--RigCalibrator.method", "known"),
+              {"method known needs the intrinsics of camera cam0 from "
+               "database " +
+                   fisheye +
+                   ", but its camera 2 has the model FISHEYE (model id 15, "
+                   "COLMAP >= 4.0), which COLMAP 3.8 (this build) does not "
+                   "know",
+               "--RigCalibrator.intrinsics_path"});
 }
 
 TEST_F(CalibrateCommandBadInput, NonColmapFilesAsModel) {

@@ -46,6 +46,64 @@ TEST(RigLayout, SameFileNamesAcrossCameraFolders) {
       << table;
 }
 
+TEST(RigLayout, GivenFramesAreTheFramesets) {
+  // COLMAP rig_configurator's frames: the names after the prefix differ, the
+  // timestamp tolerance is not used, an image without a frame is alone.
+  const std::vector<std::string> names = {
+      "cam0/a.png", "cam0/b.png", "cam1/x.png", "cam1/y.png", "cam1/z.png"};
+  RigLayoutOptions options;
+  options.frame_ids = {7, 3, 3, 7, -1};
+  options.frame_source = "the test's frames";
+  options.timestamp_tolerance = 5;
+  RigLayout layout;
+  std::string error;
+  ASSERT_TRUE(DiscoverRigLayout(names, options, &layout, &error)) << error;
+  EXPECT_EQ(layout.frameset_names,
+            (std::vector<std::string>{"a.png", "b.png", "z.png"}));
+  EXPECT_EQ(Where(layout, 3),
+            std::make_pair(std::string("cam1"), std::string("a.png")));
+  EXPECT_EQ(Where(layout, 2),
+            std::make_pair(std::string("cam1"), std::string("b.png")));
+  EXPECT_EQ(layout.unmatched_images, (std::vector<int>{4}));
+  const std::string table = RigLayoutTable(names, layout);
+  EXPECT_NE(table.find("Rig layout: 2 cameras, 3 framesets (from the test's "
+                       "frames)"),
+            std::string::npos)
+      << table;
+
+  // Without them the names decide: five framesets of one image, and the
+  // cameras never meet.
+  options.frame_ids.clear();
+  options.timestamp_tolerance = 0;
+  EXPECT_FALSE(DiscoverRigLayout(names, options, &layout, &error));
+  EXPECT_NE(error.find("never share a frameset"), std::string::npos) << error;
+
+  // A frame with two images of one camera prefix.
+  options.frame_ids = {1, 1, 2, 3, 4};
+  EXPECT_FALSE(DiscoverRigLayout(names, options, &layout, &error));
+  EXPECT_NE(error.find("frame 1 of the test's frames holds two images of "
+                       "camera cam0/ (cam0/a.png, cam0/b.png)"),
+            std::string::npos)
+      << error;
+}
+
+TEST(RigLayout, TheTableSaysWhereTheFramesetsComeFrom) {
+  RigLayout layout;
+  std::string error;
+  const std::vector<std::string> names = {"cam0/1.png", "cam1/1.png"};
+  ASSERT_TRUE(DiscoverRigLayout(names, RigLayoutOptions(), &layout, &error));
+  EXPECT_NE(RigLayoutTable(names, layout)
+                .find("1 framesets (from identical names after the camera "
+                      "prefix)"),
+            std::string::npos);
+  RigLayoutOptions timed;
+  timed.timestamp_tolerance = 2.5;
+  ASSERT_TRUE(DiscoverRigLayout(names, timed, &layout, &error));
+  EXPECT_NE(RigLayoutTable(names, layout)
+                .find("(from numeric names (timestamps) within 2.5)"),
+            std::string::npos);
+}
+
 TEST(RigLayout, UnmatchedAndIgnoredImagesAreReported) {
   const std::vector<std::string> names = {
       "cam0/a.png", "cam1/a.png", "cam0/b.png", "readme.txt", "cam1/c.png"};

@@ -1,0 +1,108 @@
+// The comparison of a calibration with a known rig (e.g. the sensor_from_rig
+// of a COLMAP database's rig_sensors) and its place in
+// calibration_summary.json.
+#include "colmap_ext/io/calibration_summary.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/testing.h"
+
+namespace rig_calibrator {
+namespace {
+
+Rigid3d Pose(const double angle, const Eigen::Vector3d& axis,
+             const Eigen::Vector3d& translation) {
+  return Rigid3d(
+      Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())),
+      translation);
+}
+
+// Three cameras; the summary's rig frame is cam0's, the known rig's
+// reference is cam1, so the comparison must re-express the result:
+// cam_from_cam1 = cam_from_rig * (cam1_from_rig)^-1.
+TEST(CompareWithKnownRig, ComparesInTheKnownRigsReferenceFrame) {
+  const Rigid3d cam1_from_rig =
+      Pose(0.4, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.2, 0, 0));
+  const Rigid3d cam2_from_rig =
+      Pose(-0.7, Eigen::Vector3d(0, 1, 0.1), Eigen::Vector3d(-0.1, 0.05, 0.3));
+  CalibrationSummary summary;
+  summary.cameras.resize(3);
+  const char* names[] = {"cam0", "cam1", "cam2"};
+  for (int c = 0; c < 3; ++c) summary.cameras[c].name = names[c];
+  summary.cameras[0].cam_from_rig = Rigid3d();
+  summary.cameras[1].cam_from_rig = cam1_from_rig;
+  summary.cameras[2].cam_from_rig = cam2_from_rig;
+
+  // The known rig: cam2 off by 0.01 rad about z and 3 mm along x; cam0
+  // exact; its reference cam1 is not compared.
+  const Rigid3d exact_cam2_from_cam1 = cam2_from_rig * cam1_from_rig.Inverse();
+  const Rigid3d error =
+      Pose(0.01, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.003, 0, 0));
+  KnownRigPrior prior;
+  prior.source = "database test.db, rig 2 (rig_sensors)";
+  prior.reference_camera = 1;
+  prior.cam_from_ref = {cam1_from_rig.Inverse(), Rigid3d(),
+                        error * exact_cam2_from_cam1};
+  CompareWithKnownRig(prior, &summary);
+
+  EXPECT_EQ(summary.known_rig_source, prior.source);
+  EXPECT_EQ(summary.known_rig_reference_camera, "cam1");
+  ASSERT_EQ(summary.known_rig_comparison.size(), 2u);
+  EXPECT_EQ(summary.known_rig_comparison[0].camera, "cam0");
+  EXPECT_NEAR(summary.known_rig_comparison[0].rotation_error_deg, 0, 1e-9);
+  EXPECT_NEAR(summary.known_rig_comparison[0].translation_error, 0, 1e-12);
+  EXPECT_NEAR(summary.known_rig_comparison[0].known_translation_norm, 0.2,
+              1e-12);
+  const KnownPoseComparison& cam2 = summary.known_rig_comparison[1];
+  EXPECT_EQ(cam2.camera, "cam2");
+  EXPECT_NEAR(cam2.rotation_error_deg, 0.01 * 180 / M_PI, 1e-9);
+  // t_known = R_e t + t_e; t_calibrated = t.
+  const Eigen::Vector3d t = exact_cam2_from_cam1.translation;
+  const Eigen::Vector3d t_known = error.rotation * t + error.translation;
+  EXPECT_NEAR(cam2.translation_error, (t - t_known).norm(), 1e-12);
+  EXPECT_NEAR(cam2.known_translation_norm, t_known.norm(), 1e-12);
+
+  testing::ScopedTempDir temp;
+  const std::string path = temp.File("calibration_summary.json");
+  std::string write_error;
+  ASSERT_TRUE(WriteCalibrationSummaryJson(path, summary, &write_error))
+      << write_error;
+  std::ifstream file(path);
+  const nlohmann::json known = nlohmann::json::parse(file)["known_rig"];
+  EXPECT_EQ(known["source"], prior.source);
+  EXPECT_EQ(known["reference_camera"], "cam1");
+  ASSERT_EQ(known["cameras"].size(), 2u);
+  EXPECT_EQ(known["cameras"][1]["name"], "cam2");
+  EXPECT_NEAR(known["cameras"][1]["rotation_error_deg"].get<double>(),
+              cam2.rotation_error_deg, 1e-12);
+}
+
+TEST(CompareWithKnownRig, NothingWithoutAPriorOrACalibratedReference) {
+  CalibrationSummary summary;
+  summary.cameras.resize(2);
+  summary.cameras[0].cam_from_rig = Rigid3d();
+  CompareWithKnownRig(KnownRigPrior(), &summary);
+  EXPECT_TRUE(summary.known_rig_source.empty());
+
+  KnownRigPrior prior;
+  prior.source = "database test.db, rig 2 (rig_sensors)";
+  prior.reference_camera = 1;  // not calibrated
+  prior.cam_from_ref = {Rigid3d(), Rigid3d()};
+  CompareWithKnownRig(prior, &summary);
+  EXPECT_TRUE(summary.known_rig_source.empty());
+  EXPECT_TRUE(summary.known_rig_comparison.empty());
+
+  testing::ScopedTempDir temp;
+  const std::string path = temp.File("calibration_summary.json");
+  std::string error;
+  ASSERT_TRUE(WriteCalibrationSummaryJson(path, summary, &error)) << error;
+  std::ifstream file(path);
+  EXPECT_TRUE(nlohmann::json::parse(file)["known_rig"].is_null());
+}
+
+}  // namespace
+}  // namespace rig_calibrator
