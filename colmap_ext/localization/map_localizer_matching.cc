@@ -163,8 +163,13 @@ bool MapLocalizer::MatchMapImages(
     }
     const std::vector<colmap::point3D_t>& map_point3D_ids =
         map_.image_point3D_ids.at(map_image_id);
-    colmap::MatchSiftFeaturesCPU(options_.sift_matching, descriptors,
-                                 map_descriptors, &matches);
+    // Exhaustive, not MatchSiftFeaturesCPU: COLMAP 3.8's CPU matcher builds a
+    // FLANN forest per pair inside its library, seeded from
+    // std::random_device (see descriptor_kd_forest.h), so its matches
+    // changed from run to run. The exhaustive matcher applies the same ratio,
+    // distance and cross-check tests to the exact nearest neighbours.
+    colmap::MatchSiftFeaturesCPUBruteForce(options_.sift_matching, descriptors,
+                                           map_descriptors, &matches);
     const size_t num_before = candidates->size();
     for (const colmap::FeatureMatch& match : matches) {
       const colmap::point3D_t point3D_id = map_point3D_ids[match.point2D_idx2];
