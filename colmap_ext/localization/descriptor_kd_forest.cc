@@ -82,13 +82,19 @@ class DescriptorKdForest::Index {
 DescriptorKdForest::DescriptorKdForest(
     const colmap::FeatureDescriptors& descriptors, const int num_trees,
     const unsigned int seed)
-    : index_(std::make_unique<Index>(descriptors, num_trees, seed)) {}
+    : index_(descriptors.rows() > 0
+                 ? std::make_unique<Index>(descriptors, num_trees, seed)
+                 : nullptr) {}
 
 DescriptorKdForest::~DescriptorKdForest() = default;
 
 void DescriptorKdForest::KnnSearch(const colmap::FeatureDescriptors& query,
                                    const int k, const int num_checks,
                                    IndexMatrix* indices) const {
+  if (index_ == nullptr) {
+    indices->setConstant(query.rows(), k, -1);
+    return;
+  }
   index_->KnnSearch(query, k, num_checks, indices);
 }
 

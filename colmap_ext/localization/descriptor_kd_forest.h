@@ -27,9 +27,10 @@ class DescriptorKdForest {
   using IndexMatrix =
       Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-  // Indexes the rows of `descriptors` (128 columns), which must outlive the
-  // forest and stay unchanged. Deterministic for (descriptors, num_trees,
-  // seed) as long as no other thread calls std::rand during the build.
+  // Indexes the rows of `descriptors` (128 columns; none is fine), which must
+  // outlive the forest and stay unchanged. Deterministic for (descriptors,
+  // num_trees, seed) as long as no other thread calls std::rand during the
+  // build.
   DescriptorKdForest(const colmap::FeatureDescriptors& descriptors,
                      int num_trees, unsigned int seed);
   ~DescriptorKdForest();

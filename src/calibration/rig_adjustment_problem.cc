@@ -164,16 +164,20 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
     return solver_options;
   }
   // The rig poses (one vector: address order = frameset order) in group 0,
-  // every other block in a group of its own, in the order it was added.
+  // then every camera's blocks in groups of their own, in camera order
+  // (Problem::GetParameterBlocks lists by address too).
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  std::vector<double*> blocks;
-  problem.GetParameterBlocks(&blocks);
-  int group = 1;
-  for (double* block : blocks) {
-    ordering->AddElementToGroup(block, group++);
-  }
   for (double* block : eliminated) {
     ordering->AddElementToGroup(block, 0);
+  }
+  int group = 1;
+  for (size_t camera = 0; camera < cameras_.size(); ++camera) {
+    for (double* block :
+         {cam_from_rig_[camera].data(), cameras_[camera].ParamsData()}) {
+      if (problem.HasParameterBlock(block)) {
+        ordering->AddElementToGroup(block, group++);
+      }
+    }
   }
   solver_options.linear_solver_ordering = ordering;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
