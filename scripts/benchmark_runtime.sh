@@ -74,7 +74,7 @@ localization_s=$(sed -n 's/^  .* 2D-3D correspondences for .* in \([0-9.]*\) s$/
 calibration_s=$(sed -n 's/^== Result (.*, \([0-9.]*\) s)$/\1/p' "$demo_log" | tail -n 1)
 render_s=$(sed -n 's/^  render ([^)]*) *\([0-9][0-9]*\) s$/\1/p' "$demo_log")
 total_s=$(sed -n 's/^  total *\([0-9][0-9]*\) s$/\1/p' "$demo_log")
-summary="$work/demo/rig/calibration/calibration_summary.json"
+timings_file="$work/demo/rig/calibration/timings.json"
 
 {
   echo "# Rendered demo: end-to-end time"
@@ -93,12 +93,12 @@ summary="$work/demo/rig/calibration/calibration_summary.json"
   [[ -n "$localization_s" ]] && echo "| ours | of which localization against the map | $localization_s |"
   [[ -n "$calibration_s" ]] && echo "| ours | of which calibration core | $calibration_s |"
   [[ -n "$total_s" ]] && echo "| all | total (with evaluation) | $total_s |"
-  if [[ -f "$summary" ]]; then
+  if [[ -f "$timings_file" ]]; then
     echo
-    echo "Calibration stages (wall s, from calibration_summary.json):"
+    echo "Calibration stages (wall s, from timings.json):"
     echo
     echo '```'
-    sed -n '/"timings_s"/,/}/p' "$summary"
+    sed -n '/"timings_s"/,/}/p' "$timings_file"
     echo '```'
   fi
 } > "$results/runtime_demo.md"

@@ -78,7 +78,8 @@ int RunCalibrate(int argc, char** argv) {
     return PrintError("calibration failed: " + report.error);
   }
   const CalibrationSummary summary = MakeCalibrationSummary(
-      dataset, calibration, layout.camera_prefixes, report, known_rig);
+      dataset, calibration, layout.camera_prefixes, report, pipeline.seed,
+      known_rig);
   std::vector<std::string> notes;
   if (!WriteRigOutput(options.output_path, map, dataset, calibration,
                       layout.camera_prefixes, summary,
@@ -92,7 +93,8 @@ int RunCalibrate(int argc, char** argv) {
                "`colmap model_analyzer --path`), rigs/frames and "
                "rig_config.json for COLMAP >= 3.12, "
                "rig_bundle_adjuster_config.json for COLMAP 3.8, camchain.yaml "
-               "(Kalibr), calibration_summary.json, correspondences.txt."
+               "(Kalibr), calibration_summary.json, correspondences.txt, "
+               "timings.json."
             << std::endl;
   if (report.HasErrors()) {
     return PrintError("some cameras could not be calibrated (see above)");

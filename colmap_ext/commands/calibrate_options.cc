@@ -182,6 +182,7 @@ bool MakeLocalizerOptions(const CalibrateOptions& options,
   localizer_options->vocab_tree_path = options.vocab_tree_path;
   localizer_options->num_retrieved_images = options.num_retrieved_images;
   localizer_options->index.num_checks = options.num_checks;
+  localizer_options->index.seed = static_cast<unsigned int>(options.seed);
   localizer_options->max_descriptors_per_point =
       options.max_descriptors_per_point;
   localizer_options->use_database_matches = options.use_database_matches;

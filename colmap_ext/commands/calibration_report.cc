@@ -8,11 +8,13 @@ namespace rig_calibrator {
 CalibrationSummary MakeCalibrationSummary(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes,
-    const PipelineReport& report, const KnownRigPrior& known_rig) {
+    const PipelineReport& report, const unsigned int seed,
+    const KnownRigPrior& known_rig) {
   CalibrationSummary summary =
       SummarizeCalibration(dataset, calibration, image_prefixes);
   CompareWithKnownRig(known_rig, &summary);
   summary.method = CalibrationMethodName(report.used_method);
+  summary.seed = seed;
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);
@@ -27,8 +29,9 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
                  const CalibrationSummary& summary,
                  const std::vector<std::string>& notes) {
   std::cout << "\n== Result (" << CalibrationMethodName(report.used_method)
-            << ", " << report.num_used << " of " << report.num_images
-            << " images used, " << report.num_framesets_posed << " of "
+            << ", seed " << summary.seed << ", " << report.num_used << " of "
+            << report.num_images << " images used, "
+            << report.num_framesets_posed << " of "
             << dataset.frameset_names.size() << " framesets, RMS "
             << std::setprecision(3) << report.final_rms_px << " px, "
             << std::fixed << std::setprecision(1) << report.total_seconds

@@ -10,18 +10,18 @@
 
 namespace rig_calibrator {
 
-// SummarizeCalibration with the method, diagnostics and stage timings of
-// the pipeline's report, compared with `known_rig` (if it has a reference
-// camera).
+// SummarizeCalibration with the seed and the method, diagnostics and stage
+// timings of the pipeline's report, compared with `known_rig` (if it has a
+// reference camera).
 CalibrationSummary MakeCalibrationSummary(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes,
-    const PipelineReport& report,
+    const PipelineReport& report, unsigned int seed,
     const KnownRigPrior& known_rig = KnownRigPrior());
 
-// "== Result (...)", a line per camera (model, focal length, principal
-// point, center in the rig, images used, RMS), the comparison with a known
-// rig, then the diagnostics and the notes of the output writer.
+// "== Result (method, seed, ...)", a line per camera (model, focal length,
+// principal point, center in the rig, images used, RMS), the comparison with
+// a known rig, then the diagnostics and the notes of the output writer.
 void PrintResult(const RigDataset& dataset, const PipelineReport& report,
                  const CalibrationSummary& summary,
                  const std::vector<std::string>& notes);

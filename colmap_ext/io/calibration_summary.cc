@@ -57,6 +57,24 @@ CalibrationSummary SummarizeCalibration(
   return summary;
 }
 
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// JSON has no NaN or infinity; a non-finite value becomes null.
+Json Number(const double value) {
+  return std::isfinite(value) ? Json(value) : Json(nullptr);
+}
+
+bool WriteJson(const std::string& path, const Json& root, std::string* error) {
+  return WriteFileAtomically(
+      path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
+      error);
+}
+
+}  // namespace
+
+
 void CompareWithKnownRig(const KnownRigPrior& prior,
                          CalibrationSummary* summary) {
   const int ref = prior.reference_camera;
@@ -90,13 +108,9 @@ void CompareWithKnownRig(const KnownRigPrior& prior,
 bool WriteCalibrationSummaryJson(const std::string& path,
                                  const CalibrationSummary& summary,
                                  std::string* error) {
-  using Json = nlohmann::ordered_json;
-  // JSON has no NaN or infinity; a non-finite value becomes null.
-  auto number = [](double value) {
-    return std::isfinite(value) ? Json(value) : Json(nullptr);
-  };
   Json root;
   root["method"] = summary.method;
+  root["seed"] = summary.seed;
   root["units"] = summary.units;
   root["map_looks_metric"] = summary.map_looks_metric
                                  ? Json(*summary.map_looks_metric)
@@ -115,17 +129,17 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["height"] = camera.camera.Height();
     node["params"] = Json::array();
     for (const double param : camera.camera.Params()) {
-      node["params"].push_back(number(param));
+      node["params"].push_back(Number(param));
     }
     if (camera.cam_from_rig) {
       const Rigid3d& pose = *camera.cam_from_rig;
       node["cam_from_rig"] = {
           {"rotation_wxyz",
-           {number(pose.rotation.w()), number(pose.rotation.x()),
-            number(pose.rotation.y()), number(pose.rotation.z())}},
+           {Number(pose.rotation.w()), Number(pose.rotation.x()),
+            Number(pose.rotation.y()), Number(pose.rotation.z())}},
           {"translation",
-           {number(pose.translation.x()), number(pose.translation.y()),
-            number(pose.translation.z())}}};
+           {Number(pose.translation.x()), Number(pose.translation.y()),
+            Number(pose.translation.z())}}};
     } else {
       node["cam_from_rig"] = nullptr;
     }
@@ -133,8 +147,8 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["num_localized"] = camera.num_localized;
     node["num_used"] = camera.num_used;
     node["num_inliers"] = camera.num_inliers;
-    node["radial_rms_px"] = number(camera.radial_rms_px);
-    node["rms_px"] = number(camera.rms_px);
+    node["radial_rms_px"] = Number(camera.radial_rms_px);
+    node["rms_px"] = Number(camera.rms_px);
     cameras.push_back(node);
   }
   root["cameras"] = cameras;
@@ -147,22 +161,26 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
       known["cameras"].push_back(
           {{"name", comparison.camera},
-           {"rotation_error_deg", number(comparison.rotation_error_deg)},
-           {"translation_error", number(comparison.translation_error)},
+           {"rotation_error_deg", Number(comparison.rotation_error_deg)},
+           {"translation_error", Number(comparison.translation_error)},
            {"known_translation_norm",
-            number(comparison.known_translation_norm)}});
+            Number(comparison.known_translation_norm)}});
     }
     root["known_rig"] = known;
   }
   root["diagnostics"] = summary.diagnostics;
+  return WriteJson(path, root, error);
+}
+
+bool WriteTimingsJson(const std::string& path,
+                      const CalibrationSummary& summary, std::string* error) {
   Json timings = Json::object();
   for (const auto& [stage, seconds] : summary.timings_s) {
-    timings[stage] = number(seconds);
+    timings[stage] = Number(seconds);
   }
+  Json root;
   root["timings_s"] = timings;
-  return WriteFileAtomically(
-      path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
-      error);
+  return WriteJson(path, root, error);
 }
 
 }  // namespace rig_calibrator

@@ -1,6 +1,9 @@
 // The machine-readable summary of a calibration (calibration_summary.json):
 // per camera the model, parameters, cam_from_rig and how well the images
-// support them; globally the method, the units, diagnostics and timings.
+// support them; globally the method, the seed, the units and diagnostics.
+// The stage timings, the only part that changes from run to run, go to a
+// file of their own (timings.json), so that two runs of the same input give
+// identical summaries.
 #pragma once
 
 #include <colmap/base/camera.h>
@@ -56,6 +59,7 @@ struct KnownPoseComparison {
 struct CalibrationSummary {
   // "1dr", "rd_ra", "rd", "known", "known_refine", "known_ra"
   std::string method;
+  unsigned int seed = 0;  // --RigCalibrator.seed
   // The map's units; a calibration is metric only if the map is.
   std::string units = "map units";
   std::optional<bool> map_looks_metric;  // unknown when not assessed
@@ -69,14 +73,15 @@ struct CalibrationSummary {
   std::string known_rig_reference_camera;
   std::vector<KnownPoseComparison> known_rig_comparison;
   std::vector<std::string> diagnostics;  // warnings and notes, in order
-  std::vector<std::pair<std::string, double>> timings_s;  // stage, seconds
+  // Stage, wall seconds: written by WriteTimingsJson only.
+  std::vector<std::pair<std::string, double>> timings_s;
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller
-// sets method, units, map_looks_metric, diagnostics and timings. Camera names
-// come from the dataset, image prefixes from `image_prefixes` (one per camera,
-// or empty for name + "/"). cam_from_rig is relative to the reference camera.
-// Requires ValidateCalibration (src/calibration/rig_dataset.h).
+// sets method, seed, units, map_looks_metric, diagnostics and timings. Camera
+// names come from the dataset, image prefixes from `image_prefixes` (one per
+// camera, or empty for name + "/"). cam_from_rig is relative to the reference
+// camera. Requires ValidateCalibration (src/calibration/rig_dataset.h).
 CalibrationSummary SummarizeCalibration(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);
@@ -86,8 +91,13 @@ CalibrationSummary SummarizeCalibration(
 void CompareWithKnownRig(const KnownRigPrior& prior,
                          CalibrationSummary* summary);
 
+// Everything but the timings.
 bool WriteCalibrationSummaryJson(const std::string& path,
                                  const CalibrationSummary& summary,
                                  std::string* error);
+
+// {"timings_s": {stage: seconds, ...}}.
+bool WriteTimingsJson(const std::string& path,
+                      const CalibrationSummary& summary, std::string* error);
 
 }  // namespace rig_calibrator

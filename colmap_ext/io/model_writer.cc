@@ -394,6 +394,7 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
                                    contents->notes.end());
   return WriteCalibrationSummaryJson(folder + "/" + kSummaryFile, final_summary,
                                      error) &&
+         WriteTimingsJson(folder + "/" + kTimingsFile, final_summary, error) &&
          WriteCorrespondenceFile(folder + "/" + kCorrespondencesFile,
                                  DatasetCorrespondences(dataset), error);
 }

@@ -9,6 +9,9 @@
 //   rig_bundle_adjuster_config.json            COLMAP 3.8 rig_bundle_adjuster
 //   camchain.yaml                              Kalibr
 //   calibration_summary.json                   the summary
+//   timings.json                               wall time per stage (the only
+//                                              file that changes between runs
+//                                              of the same input)
 //   correspondences.txt                        the 2D-3D correspondences used
 #pragma once
 
@@ -29,6 +32,7 @@ inline constexpr char kRigBundleAdjusterConfigFile[] =
     "rig_bundle_adjuster_config.json";
 inline constexpr char kCamchainFile[] = "camchain.yaml";
 inline constexpr char kSummaryFile[] = "calibration_summary.json";
+inline constexpr char kTimingsFile[] = "timings.json";
 inline constexpr char kCorrespondencesFile[] = "correspondences.txt";
 
 struct RigModel {

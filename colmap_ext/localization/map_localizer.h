@@ -10,7 +10,8 @@
 //  * `direct` mode (default): each feature is looked up in a FLANN index of
 //    the map points' track descriptors (PointDescriptorIndex), built once per
 //    map, with COLMAP's ratio test against the second-best map point;
-//  * `retrieval` mode: SIFT matching (COLMAP's MatchSiftFeaturesCPU) against
+//  * `retrieval` mode: SIFT matching (COLMAP's CPU rule on seeded forests,
+//    sift_pair_matching.h) against
 //    the top map images, chosen by the vocabulary tree when one is given,
 //    else all map images for a small map, else the map images that see most
 //    of the image's direct matches.
@@ -53,8 +54,8 @@ struct MapLocalizerOptions {
   LocalizationMode mode = LocalizationMode::kDirect;
 
   // COLMAP's SiftMatching.* options. `max_ratio` (0.8) and `max_distance`
-  // (0.7 rad) apply to both modes; retrieval mode passes all of them to
-  // MatchSiftFeaturesCPU (`use_gpu` is always false).
+  // (0.7 rad) apply to both modes; retrieval mode also uses `cross_check`
+  // (MatchSiftDescriptors; `use_gpu` is always false).
   colmap::SiftMatchingOptions sift_matching;
 
   // Direct mode: descriptors kept per map point (chosen by
@@ -85,7 +86,7 @@ enum class CorrespondenceSource {
   kNone,             // no correspondence found
   kDatabaseMatches,  // two_view_geometries inlier matches
   kDirectIndex,      // PointDescriptorIndex
-  kImageMatching,    // MatchSiftFeaturesCPU against retrieved map images
+  kImageMatching,    // SIFT matching against retrieved map images
 };
 std::string CorrespondenceSourceName(CorrespondenceSource source);
 

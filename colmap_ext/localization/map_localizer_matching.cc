@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "colmap_ext/localization/map_localizer.h"
+#include "colmap_ext/localization/sift_pair_matching.h"
 
 namespace rig_calibrator {
 namespace {
@@ -157,14 +158,19 @@ bool MapLocalizer::MatchMapImages(
     int* num_map_images_matched, std::string* error) const {
   colmap::FeatureDescriptors map_descriptors;
   colmap::FeatureMatches matches;
+  const DescriptorKdForest forest(descriptors, kPairMatchingNumTrees,
+                                  options_.index.seed);
   for (const colmap::image_t map_image_id : map_image_ids) {
     if (!database_->ReadDescriptors(map_image_id, &map_descriptors, error)) {
       return false;
     }
     const std::vector<colmap::point3D_t>& map_point3D_ids =
         map_.image_point3D_ids.at(map_image_id);
-    colmap::MatchSiftFeaturesCPU(options_.sift_matching, descriptors,
-                                 map_descriptors, &matches);
+    // COLMAP's rule on seeded forests (sift_pair_matching.h).
+    const DescriptorKdForest map_forest(map_descriptors, kPairMatchingNumTrees,
+                                        options_.index.seed);
+    MatchSiftDescriptors(options_.sift_matching, descriptors, forest,
+                         map_descriptors, map_forest, &matches);
     const size_t num_before = candidates->size();
     for (const colmap::FeatureMatch& match : matches) {
       const colmap::point3D_t point3D_id = map_point3D_ids[match.point2D_idx2];

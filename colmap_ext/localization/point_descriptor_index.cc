@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <flann/flann.hpp>
 #include <limits>
 
 namespace rig_calibrator {
@@ -75,37 +74,6 @@ std::vector<int> SelectRepresentativeDescriptors(
   return selected;
 }
 
-class PointDescriptorIndex::SearchIndex {
- public:
-  SearchIndex(const colmap::FeatureDescriptors& descriptors,
-              const int num_trees)
-      : index_(flann::Matrix<uint8_t>(const_cast<uint8_t*>(descriptors.data()),
-                                      descriptors.rows(), kDescriptorDim),
-               flann::KDTreeIndexParams(num_trees)) {
-    index_.buildIndex();
-  }
-
-  // Row indices (-1: none) of the k nearest descriptors of every query.
-  void KnnSearch(const colmap::FeatureDescriptors& query, const int k,
-                 const int num_checks,
-                 Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic,
-                               Eigen::RowMajor>* indices) const {
-    indices->setConstant(query.rows(), k, -1);
-    std::vector<float> distances(query.rows() * k);
-    flann::Matrix<uint8_t> query_matrix(const_cast<uint8_t*>(query.data()),
-                                        query.rows(), kDescriptorDim);
-    flann::Matrix<int> indices_matrix(indices->data(), query.rows(), k);
-    flann::Matrix<float> distances_matrix(distances.data(), query.rows(), k);
-    flann::SearchParams search_params(num_checks);
-    search_params.cores = 1;  // callers parallelize over images
-    index_.knnSearch(query_matrix, indices_matrix, distances_matrix, k,
-                     search_params);
-  }
-
- private:
-  flann::Index<flann::L2<uint8_t>> index_;
-};
-
 PointDescriptorIndex::PointDescriptorIndex() = default;
 PointDescriptorIndex::~PointDescriptorIndex() = default;
 
@@ -129,8 +97,8 @@ void PointDescriptorIndex::BuildSearchIndex(const Options& options) {
   options_ = options;
   search_index_.reset();
   if (descriptors_.rows() > 0) {
-    search_index_ =
-        std::make_unique<SearchIndex>(descriptors_, options.num_trees);
+    search_index_ = std::make_unique<DescriptorKdForest>(
+        descriptors_, options.num_trees, options.seed);
   }
 }
 
@@ -142,7 +110,7 @@ void PointDescriptorIndex::Match(const colmap::FeatureDescriptors& query,
   if (search_index_ == nullptr || query.rows() == 0) return;
 
   const int k = std::min<int>(max_rows_per_point_ + 1, descriptors_.rows());
-  Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> indices;
+  DescriptorKdForest::IndexMatrix indices;
   search_index_->KnnSearch(query, k, options_.num_checks, &indices);
 
   for (int query_idx = 0; query_idx < query.rows(); ++query_idx) {

@@ -19,6 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "colmap_ext/localization/descriptor_kd_forest.h"
+
 namespace rig_calibrator {
 
 // COLMAP's SIFT descriptor distance: the angle between the two 128-byte
@@ -44,6 +46,9 @@ class PointDescriptorIndex {
     // accuracy; 32 checks keep 98.5 %).
     int num_trees = 4;
     int num_checks = 64;
+    // Seed of the forest's construction (DescriptorKdForest): the same
+    // descriptors, options and seed give the same matches.
+    unsigned int seed = 0;
   };
 
   // A feature matched to a map point.
@@ -64,7 +69,8 @@ class PointDescriptorIndex {
   void SetDescriptors(colmap::FeatureDescriptors descriptors,
                       std::vector<colmap::point3D_t> point3D_ids);
 
-  // Builds the kd-tree forest (single-threaded, once per map).
+  // Builds the kd-tree forest (single-threaded, once per map; deterministic
+  // for options.seed).
   void BuildSearchIndex(const Options& options);
   bool HasSearchIndex() const { return search_index_ != nullptr; }
 
@@ -87,15 +93,13 @@ class PointDescriptorIndex {
                      colmap::point3D_t point3D_id) const;
 
  private:
-  class SearchIndex;
-
   Options options_;
   colmap::FeatureDescriptors descriptors_;
   std::vector<colmap::point3D_t> point3D_ids_;
   // First row and number of rows of every point.
   std::unordered_map<colmap::point3D_t, std::pair<int, int>> point_rows_;
   int max_rows_per_point_ = 0;
-  std::unique_ptr<SearchIndex> search_index_;
+  std::unique_ptr<DescriptorKdForest> search_index_;
 };
 
 }  // namespace rig_calibrator

@@ -128,10 +128,14 @@ ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
       tz_gauge_held = true;
     }
   }
+  // Ceres lists a group's blocks by address: one group per camera block, so
+  // that the reduced system's order does not depend on where the heap put
+  // the two vectors (rig_from_world is one vector, in frameset order).
   for (int i = 0; i < num_cameras; ++i) {
     if (!cam_added[i]) continue;
-    ordering->AddElementToGroup(parameters->cam_from_rig[i].data(), 1);
-    ordering->AddElementToGroup(parameters->principal_points[i].data(), 1);
+    ordering->AddElementToGroup(parameters->cam_from_rig[i].data(), 1 + 2 * i);
+    ordering->AddElementToGroup(parameters->principal_points[i].data(),
+                                2 + 2 * i);
     if (i == reference_camera) {
       problem.SetParameterBlockConstant(parameters->cam_from_rig[i].data());
     } else {

@@ -133,14 +133,25 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
   // by several framesets, so the rig poses cannot share the group: the group
   // must be an independent set), else the variable rig poses (each seen only
   // through the shared camera blocks, leaving a tiny dense reduced system).
-  std::vector<double*> eliminated;
+  //
+  // Ceres lists the blocks of one ordering group by address (a
+  // std::set<double*>), and the points (hash-map nodes) and the camera
+  // parameters (a heap vector per camera) lie where the heap's history put
+  // them: the output folder's name changed the result at 1e-15. So no group
+  // here holds blocks at unrelated addresses. The points are left to Ceres,
+  // which, given no ordering, takes the independent set of the blocks in the
+  // order they were added to the problem, lowest degree first
+  // (ComputeStableSchurOrdering): the points, as above.
+  bool eliminate_points = false;
   for (auto& [point3D_id, point] : refined_points_) {
-    if (problem.HasParameterBlock(point.data())) {
-      eliminated.push_back(point.data());
-    }
+    eliminate_points |= problem.HasParameterBlock(point.data());
   }
-  const bool eliminate_points = !eliminated.empty();
-  if (!eliminate_points && options_.refine_rig_poses) {
+  if (eliminate_points) {
+    solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+    return solver_options;
+  }
+  std::vector<double*> eliminated;
+  if (options_.refine_rig_poses) {
     for (PoseParams& pose : rig_from_world_) {
       if (problem.HasParameterBlock(pose.data())) {
         eliminated.push_back(pose.data());
@@ -152,18 +163,24 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
     solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     return solver_options;
   }
+  // The rig poses (one vector: address order = frameset order) in group 0,
+  // then every camera's blocks in groups of their own, in camera order
+  // (Problem::GetParameterBlocks lists by address too).
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  std::vector<double*> blocks;
-  problem.GetParameterBlocks(&blocks);
-  for (double* block : blocks) {
-    ordering->AddElementToGroup(block, 1);
-  }
   for (double* block : eliminated) {
     ordering->AddElementToGroup(block, 0);
   }
+  int group = 1;
+  for (size_t camera = 0; camera < cameras_.size(); ++camera) {
+    for (double* block :
+         {cam_from_rig_[camera].data(), cameras_[camera].ParamsData()}) {
+      if (problem.HasParameterBlock(block)) {
+        ordering->AddElementToGroup(block, group++);
+      }
+    }
+  }
   solver_options.linear_solver_ordering = ordering;
-  solver_options.linear_solver_type =
-      eliminate_points ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   return solver_options;
 }
 

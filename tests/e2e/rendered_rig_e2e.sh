@@ -111,5 +111,6 @@ echo "[e2e] re-run from correspondences.txt: $((SECONDS - start)) s"
 "$checker" "$rerun" "$calibration" ||
   fail "the re-run from correspondences.txt does not reproduce the run"
 
+bash "$repo/tests/e2e/determinism_e2e.sh" "$build" "$work/demo/rig/database.db" "$work/demo/dataset/rig_images" "$work/demo/map/sparse/0" "$truth" "$work/determinism" --RigCalibrator.camera_model "$camera_models" || fail "determinism (tests/e2e/determinism_e2e.sh)"
 [[ $# -ge 2 ]] || rm -rf "$work"
 echo "[e2e] passed (demo pipeline $demo_seconds s)"
