@@ -197,7 +197,7 @@ bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
     StageTimer stage("Radial bundle adjustment", options.print_progress,
                      report);
     RadialBundleAdjustmentOptions ba_options = options.radial_bundle_adjustment;
-    ba_options.num_threads = options.num_threads;
+    ba_options.num_threads = options.SolverNumThreads();
     RadialBundleAdjustmentSummary summary;
     if (!AdjustRadialRig(ba_options, dataset, calibration, &summary)) {
       report->error = "the radial bundle adjustment failed (see above)";
@@ -264,7 +264,7 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
   StageTimer stage("Final bundle adjustment", options.print_progress, report);
   SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
   FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
-  ba_options.num_threads = options.num_threads;
+  ba_options.num_threads = options.SolverNumThreads();
   if (!RefinesIntrinsics(method)) {
     ba_options.refine_focal_length = false;
     ba_options.refine_principal_point = false;

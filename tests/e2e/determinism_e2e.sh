@@ -5,9 +5,11 @@
 #   1. two runs on 1 thread, into folders with names of different lengths:
 #      every output file identical byte for byte (timings.json, the wall times,
 #      left out);
-#   2. 1 thread against 2 threads (text outputs): correspondences.txt
-#      identical byte for byte, every other file equal token by token with
-#      numbers within 1e-9 relative (Ceres sums in thread order, see README);
+#   2. 1 thread against 2 threads: every output file identical byte for
+#      byte with the default --RigCalibrator.deterministic_solvers 1; with
+#      multithreaded solvers (0, text outputs) correspondences.txt identical
+#      and every other number within 1e-9 relative (Ceres sums in thread
+#      order, see README);
 #   3. another seed: within the e2e test's accuracy bounds of the truth
 #      (0.5 degrees, 2 cm, 1 % focal length), and its difference to seed 0.
 #
@@ -40,15 +42,17 @@ compare="$repo/tests/e2e/compare_outputs.py"
 [[ -x "$rig_calibrator" ]] || fail "no $rig_calibrator: build the project first"
 mkdir -p "$work"
 
-# calibrate NAME THREADS SEED OUTPUT_TYPE: one database run into $work/NAME.
+# calibrate NAME THREADS SEED OUTPUT_TYPE [OPTIONS...]: one database run into
+# $work/NAME.
 calibrate() {
-  local start=$SECONDS
+  local start=$SECONDS name="$1" threads="$2" seed="$3" type="$4"
+  shift 4
   "$rig_calibrator" --database_path "$database" --image_path "$rig_images" \
-    --input_path "$map_model" --output_path "$work/$1" \
-    --RigCalibrator.num_threads "$2" --RigCalibrator.seed "$3" \
-    --output_type "$4" "${options[@]}" > "$work/$1.log" 2>&1 ||
-    fail "rig_calibrator ($1; log: $work/$1.log)"
-  echo "[determinism] $1: $2 thread(s), seed $3, $4: $((SECONDS - start)) s"
+    --input_path "$map_model" --output_path "$work/$name" \
+    --RigCalibrator.num_threads "$threads" --RigCalibrator.seed "$seed" \
+    --output_type "$type" "${options[@]}" "$@" > "$work/$name.log" 2>&1 ||
+    fail "rig_calibrator ($name; log: $work/$name.log)"
+  echo "[determinism] $name: $threads thread(s), seed $seed, $type $*: $((SECONDS - start)) s"
 }
 
 # 1. Bit for bit on 1 thread, whatever the output folder is called.
@@ -59,13 +63,18 @@ python3 "$compare" "$work/bin_1thread" "$work/$long_name" --ignore timings.json 
   fail "two runs on 1 thread differ"
 echo "[determinism] two runs on 1 thread: every output file identical"
 
-# 2. 1 thread against 2 threads.
-calibrate txt_1thread 1 0 TXT
-calibrate txt_2threads 2 0 TXT
+# 2. 1 thread against 2 threads: bit for bit with deterministic solvers (the
+# default), within 1e-9 with multithreaded ones.
+calibrate bin_2threads 2 0 BIN
+python3 "$compare" "$work/bin_1thread" "$work/bin_2threads" --ignore timings.json ||
+  fail "1 and 2 threads differ"
+echo "[determinism] 1 and 2 threads: every output file identical"
+calibrate txt_1thread 1 0 TXT --RigCalibrator.deterministic_solvers 0
+calibrate txt_2threads 2 0 TXT --RigCalibrator.deterministic_solvers 0
 python3 "$compare" "$work/txt_1thread" "$work/txt_2threads" --tolerance 1e-9 \
   --exact correspondences.txt --ignore timings.json ||
-  fail "1 and 2 threads differ by more than 1e-9"
-echo "[determinism] 1 and 2 threads: identical correspondences, every number within 1e-9"
+  fail "multithreaded solvers: 1 and 2 threads differ by more than 1e-9"
+echo "[determinism] multithreaded solvers, 1 and 2 threads: identical correspondences, every number within 1e-9"
 
 # 3. Another seed: other trees, other RANSAC samples, the same accuracy.
 calibrate bin_seed1 2 1 BIN
