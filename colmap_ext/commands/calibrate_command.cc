@@ -62,6 +62,7 @@ int RunCalibrate(int argc, char** argv) {
           ? LoadFromCorrespondences(options, &dataset, &layout, &error)
           : LoadFromDatabase(options, map, &dataset, &layout, &error);
   if (!loaded) return PrintError(error);
+  AddMapImages(map, &dataset);
 
   RigCalibration calibration;
   PipelineReport report;

@@ -65,6 +65,23 @@ void AddRigCalibratorOptions(po::options_description* description,
             "twice in the final bundle adjustment (the result is then "
             "aligned back to the map by a similarity); 0: keep the map "
             "points fixed");
+  AddOption(description, "RigCalibrator.map_observations",
+            &o->map_observations,
+            "with refine_points and a map (--input_path): the map images' "
+            "observations of the refined points are residuals too, the map "
+            "images' poses and cameras held fixed");
+  AddOption(description, "RigCalibrator.refine_map", &o->refine_map,
+            "also adjust every map image's pose and every map point with the "
+            "rig (needs refine_points and map_observations); the result is "
+            "aligned to the input map's camera centres by a similarity");
+  AddOption(description, "RigCalibrator.refine_map_intrinsics",
+            &o->refine_map_intrinsics,
+            "with refine_map: also adjust the map cameras' intrinsics");
+  AddUnsetOption(description, "RigCalibrator.export_database",
+                 &o->export_database,
+                 "write a copy of --database_path with the rig images' "
+                 "verified matches to the map images (for COLMAP's "
+                 "point_triangulator, mapper, bundle_adjuster); a new file");
   AddOption(description, "RigCalibrator.radial_max_error",
             &o->radial_max_error_px,
             "inlier threshold of the 1D radial stages (pixels)");
@@ -161,6 +178,32 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
   pipeline->radial_bundle_adjustment.loss_scale_px = options->loss_scale_px;
   pipeline->final_bundle_adjustment.loss_scale_px = options->loss_scale_px;
   pipeline->final_bundle_adjustment.refine_points = options->refine_points;
+  pipeline->final_bundle_adjustment.use_map_observations =
+      options->map_observations;
+  pipeline->final_bundle_adjustment.refine_map = options->refine_map;
+  pipeline->final_bundle_adjustment.refine_map_intrinsics =
+      options->refine_map_intrinsics;
+  if (options->refine_map &&
+      (!options->refine_points || !options->map_observations ||
+       options->input_path.empty())) {
+    *error =
+        "--RigCalibrator.refine_map 1 needs --RigCalibrator.refine_points 1, "
+        "--RigCalibrator.map_observations 1 and the map (--input_path)";
+    return false;
+  }
+  if (options->refine_map_intrinsics && !options->refine_map) {
+    *error =
+        "--RigCalibrator.refine_map_intrinsics 1 needs "
+        "--RigCalibrator.refine_map 1";
+    return false;
+  }
+  if (!options->export_database.empty() &&
+      (options->database_path.empty() || options->input_path.empty())) {
+    *error =
+        "--RigCalibrator.export_database needs the map's database "
+        "(--database_path) and model (--input_path)";
+    return false;
+  }
   return true;
 }
 

@@ -33,6 +33,15 @@ struct CalibrateOptions {
   // projection difference 0.7 -> 0.08 px); the result stays anchored to the
   // map by a similarity.
   bool refine_points = true;
+  // The map images' observations of the refined points take part in the
+  // final bundle adjustment (map poses and intrinsics fixed); refine_map:
+  // the map images' poses (refine_map_intrinsics: and the map cameras) are
+  // adjusted with the rig (final_bundle_adjuster.h).
+  bool map_observations = true;
+  bool refine_map = false;
+  bool refine_map_intrinsics = false;
+  // A new database (copy of --database_path) with the rig-to-map matches.
+  std::string export_database;
   double radial_max_error_px = 8.0;
   double max_reprojection_error_px = 10.0;
   double loss_scale_px = 1.0;

@@ -114,6 +114,17 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     timings[stage] = number(seconds);
   }
   root["timings_s"] = timings;
+  if (summary.map_images) {
+    const MapImagesSummary& map = *summary.map_images;
+    root["map_images"] = {
+        {"input_mean_error_px", number(map.input_mean_error_px)},
+        {"output_mean_error_px", number(map.output_mean_error_px)},
+        {"input_max_error_px", number(map.input_max_error_px)},
+        {"output_max_error_px", number(map.output_max_error_px)},
+        {"num_input_observations", map.num_input_observations},
+        {"num_output_observations", map.num_output_observations},
+        {"num_dropped_observations", map.num_dropped_observations}};
+  }
   return WriteFileAtomically(
       path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
       error);
