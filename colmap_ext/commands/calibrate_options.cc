@@ -1,6 +1,7 @@
 #include "colmap_ext/commands/calibrate_options.h"
 
 #include <boost/algorithm/string.hpp>
+#include <boost/filesystem.hpp>
 
 #include "colmap_ext/commands/command_options.h"
 
@@ -71,9 +72,10 @@ void AddRigCalibratorOptions(po::options_description* description,
             "observations of the refined points are residuals too, the map "
             "images' poses and cameras held fixed");
   AddOption(description, "RigCalibrator.refine_map", &o->refine_map,
-            "also adjust every map image's pose and every map point with the "
-            "rig (needs refine_points and map_observations); the result is "
-            "aligned to the input map's camera centres by a similarity");
+            "adjust every map image's pose and every map point with the rig "
+            "(with refine_points, map_observations and a map; the result is "
+            "aligned to the input map's camera centres by a similarity); 0: "
+            "the map images' poses stay fixed");
   AddOption(description, "RigCalibrator.refine_map_intrinsics",
             &o->refine_map_intrinsics,
             "with refine_map: also adjust the map cameras' intrinsics");
@@ -180,17 +182,13 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
   pipeline->final_bundle_adjustment.refine_points = options->refine_points;
   pipeline->final_bundle_adjustment.use_map_observations =
       options->map_observations;
-  pipeline->final_bundle_adjustment.refine_map = options->refine_map;
+  // The map is adjusted with the rig only where there is one to adjust.
+  pipeline->final_bundle_adjustment.refine_map =
+      options->refine_map && options->refine_points &&
+      options->map_observations && !options->input_path.empty();
   pipeline->final_bundle_adjustment.refine_map_intrinsics =
+      pipeline->final_bundle_adjustment.refine_map &&
       options->refine_map_intrinsics;
-  if (options->refine_map &&
-      (!options->refine_points || !options->map_observations ||
-       options->input_path.empty())) {
-    *error =
-        "--RigCalibrator.refine_map 1 needs --RigCalibrator.refine_points 1, "
-        "--RigCalibrator.map_observations 1 and the map (--input_path)";
-    return false;
-  }
   if (options->refine_map_intrinsics && !options->refine_map) {
     *error =
         "--RigCalibrator.refine_map_intrinsics 1 needs "
@@ -203,6 +201,15 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
         "--RigCalibrator.export_database needs the map's database "
         "(--database_path) and model (--input_path)";
     return false;
+  }
+  if (!options->export_database.empty()) {
+    // Checked before the calibration, so that a bad path costs no run.
+    boost::system::error_code code;
+    if (boost::filesystem::exists(options->export_database, code)) {
+      *error = "--RigCalibrator.export_database " + options->export_database +
+               " exists; give the path of a new file (it never overwrites)";
+      return false;
+    }
   }
   return true;
 }
