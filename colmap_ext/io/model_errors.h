@@ -32,7 +32,7 @@ ReprojectionStats ComputeReprojectionStats(
 
 // Sets every point's error to the mean of its observations' reprojection
 // errors, COLMAP's definition (Point3D::Error; model_analyzer's mean
-// reprojection error is the track-length-weighted mean of these).
+// reprojection error is the mean of these over the points).
 void RecomputePointErrors(colmap::Reconstruction* model);
 
 }  // namespace rig_calibrator
