@@ -66,8 +66,7 @@ void AddRigCalibratorOptions(po::options_description* description,
             "twice in the final bundle adjustment (the result is then "
             "aligned back to the map by a similarity); 0: keep the map "
             "points fixed");
-  AddOption(description, "RigCalibrator.map_observations",
-            &o->map_observations,
+  AddOption(description, "RigCalibrator.map_observations", &o->map_observations,
             "with refine_points and a map (--input_path): the map images' "
             "observations of the refined points are residuals too, the map "
             "images' poses and cameras held fixed");

@@ -52,7 +52,7 @@ struct CalibrationSummary {
   std::vector<CameraSummary> cameras;
   std::vector<std::string> diagnostics;  // warnings and notes, in order
   std::vector<std::pair<std::string, double>> timings_s;  // stage, seconds
-  std::optional<MapImagesSummary> map_images;  // with a map
+  std::optional<MapImagesSummary> map_images;             // with a map
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -25,10 +25,9 @@ constexpr double kKeypointTolerancePx = 1e-3;
 // none; `order` sorts the keypoints by x.
 int FindKeypoint(const colmap::FeatureKeypoints& keypoints,
                  const std::vector<int>& order, const Eigen::Vector2d& xy) {
-  auto it = std::lower_bound(order.begin(), order.end(),
-                             xy.x() - kKeypointTolerancePx, [&](int k, double x) {
-                               return keypoints[k].x < x;
-                             });
+  auto it = std::lower_bound(
+      order.begin(), order.end(), xy.x() - kKeypointTolerancePx,
+      [&](int k, double x) { return keypoints[k].x < x; });
   for (; it != order.end() && keypoints[*it].x <= xy.x() + kKeypointTolerancePx;
        ++it) {
     if (std::abs(keypoints[*it].y - xy.y()) <= kKeypointTolerancePx) {
@@ -126,7 +125,8 @@ bool ExportDatabaseWithRigMatches(const std::string& database_path,
               static_cast<colmap::point3D_t>(correspondence.point3D_id))) {
         continue;
       }
-      const int keypoint = FindKeypoint(keypoints, order, correspondence.point2D);
+      const int keypoint =
+          FindKeypoint(keypoints, order, correspondence.point2D);
       if (keypoint < 0) {
         ++summary->num_unmatched_rows;
         continue;
@@ -151,11 +151,12 @@ bool ExportDatabaseWithRigMatches(const std::string& database_path,
     summary->num_rig_images += has_match ? 1 : 0;
   }
   for (const auto& [image_id, image] : map.Images()) {
-    if (const DatabaseImage* map_image = reader.FindImageWithName(image.Name())) {
-      cam_from_world[map_image->image_id] = Rigid3d(
-          Eigen::Quaterniond(image.Qvec()(0), image.Qvec()(1), image.Qvec()(2),
-                             image.Qvec()(3)),
-          image.Tvec());
+    if (const DatabaseImage* map_image =
+            reader.FindImageWithName(image.Name())) {
+      cam_from_world[map_image->image_id] =
+          Rigid3d(Eigen::Quaterniond(image.Qvec()(0), image.Qvec()(1),
+                                     image.Qvec()(2), image.Qvec()(3)),
+                  image.Tvec());
     }
   }
   // A database camera shared with another rig camera keeps its parameters.
@@ -165,10 +166,9 @@ bool ExportDatabaseWithRigMatches(const std::string& database_path,
   }
   reader.Close();
 
-  const fs::path temporary =
-      fs::path(export_path).parent_path() /
-      ("." + fs::path(export_path).filename().string() + ".tmp-" +
-       std::to_string(getpid()));
+  const fs::path temporary = fs::path(export_path).parent_path() /
+                             ("." + fs::path(export_path).filename().string() +
+                              ".tmp-" + std::to_string(getpid()));
   std::error_code code;
   fs::copy_file(database_path, temporary, fs::copy_options::overwrite_existing,
                 code);

@@ -50,9 +50,8 @@ void RecomputePointErrors(colmap::Reconstruction* model) {
     for (const colmap::TrackElement& element : point3D.Track().Elements()) {
       sum += ObservationError(*model, element.image_id, element.point2D_idx);
     }
-    point3D.SetError(point3D.Track().Length() > 0
-                         ? sum / point3D.Track().Length()
-                         : 0);
+    point3D.SetError(
+        point3D.Track().Length() > 0 ? sum / point3D.Track().Length() : 0);
   }
 }
 

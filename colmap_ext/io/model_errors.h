@@ -22,7 +22,8 @@ struct ReprojectionStats {
 // The reprojection error of observation (image_id, point2D_idx) of a point
 // of `model` (infinite behind the camera).
 double ObservationError(const colmap::Reconstruction& model,
-                        colmap::image_t image_id, colmap::point2D_t point2D_idx);
+                        colmap::image_t image_id,
+                        colmap::point2D_t point2D_idx);
 
 // Over every observation of a point by the images in `image_ids` (all
 // registered images if empty).

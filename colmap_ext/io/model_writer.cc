@@ -5,9 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <optional>
 #include <sstream>
-#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 

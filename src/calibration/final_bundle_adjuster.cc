@@ -126,8 +126,7 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& options,
           << " observations, " << result.num_outliers << " outliers; map RMS "
           << result.map_initial_rms_px << " -> " << result.map_final_rms_px
           << " px over " << result.num_map_residuals << " observations, "
-          << result.num_map_outliers << " outliers, "
-          << result.seconds << " s";
+          << result.num_map_outliers << " outliers, " << result.seconds << " s";
   if (summary != nullptr) {
     *summary = result;
   }

@@ -284,7 +284,8 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
     if (summary.num_map_residuals > 0) {
       std::cout << "  map images: RMS " << summary.map_initial_rms_px << " -> "
                 << summary.map_final_rms_px << " px over "
-                << summary.num_map_residuals << " observations of refined "
+                << summary.num_map_residuals
+                << " observations of refined "
                    "points, "
                 << summary.num_map_outliers << " rejected" << std::endl;
     }

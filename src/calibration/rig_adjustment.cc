@@ -257,12 +257,12 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
     for (size_t i = 0; i < dataset_.map_images.size(); ++i) {
       const MapImage& image = dataset_.map_images[i];
       calibration->map_cam_from_world.push_back(
-          map_cam_from_world_.empty()
-              ? image.cam_from_world
-              : FromPoseParams(map_cam_from_world_[i]));
+          map_cam_from_world_.empty() ? image.cam_from_world
+                                      : FromPoseParams(map_cam_from_world_[i]));
       calibration->map_observation_rejected.push_back(
-          map_rejected_.empty() ? std::vector<char>(image.observations.size(), 0)
-                                : map_rejected_[i]);
+          map_rejected_.empty()
+              ? std::vector<char>(image.observations.size(), 0)
+              : map_rejected_[i]);
     }
   }
 }

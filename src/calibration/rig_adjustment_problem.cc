@@ -1,7 +1,8 @@
 // The Ceres problem of the final bundle adjustment: one RigReprojectionCost
 // per observation (a map image's: its cam_from_world as the "rig" pose, a
-// constant identity cam_from_rig), the blocks that are held constant or partly constant, and
-// the solver set-up (Schur elimination of the rig poses or map points).
+// constant identity cam_from_rig), the blocks that are held constant or partly
+// constant, and the solver set-up (Schur elimination of the rig poses or map
+// points).
 #include <glog/logging.h>
 
 #include <algorithm>

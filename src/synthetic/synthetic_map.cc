@@ -49,8 +49,8 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
   std::uniform_real_distribution<double> unit(-1, 1);
   for (int m = 0; m < options.num_map_images; ++m) {
     const int c = m % num_cameras;
-    const int j = std::min(num_framesets - 1,
-                           m * num_framesets / options.num_map_images);
+    const int j =
+        std::min(num_framesets - 1, m * num_framesets / options.num_map_images);
     const Rigid3d rig_camera =
         rig->truth.cam_from_rig[c] * rig->truth.rig_from_world[j];
     // Rotated by up to 3 degrees about a random axis, the center moved by
@@ -73,10 +73,12 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
     image.cam_from_world = cam_from_world;
     for (size_t id = 0; id < truth.size(); ++id) {
       const Eigen::Vector3d point_in_cam = cam_from_world * truth[id];
-      if (point_in_cam.z() <= 0 || point_in_cam.norm() > 2 * options.max_depth) {
+      if (point_in_cam.z() <= 0 ||
+          point_in_cam.norm() > 2 * options.max_depth) {
         continue;
       }
-      const Eigen::Vector2d xy = camera.WorldToImage(point_in_cam.hnormalized());
+      const Eigen::Vector2d xy =
+          camera.WorldToImage(point_in_cam.hnormalized());
       if (xy.x() < 0 || xy.y() < 0 || xy.x() > camera.Width() ||
           xy.y() > camera.Height()) {
         continue;

@@ -71,10 +71,9 @@ void CheckMeanError(const colmap::Reconstruction& model) {
     sum += point_sum;
     sum_of_point_means += point_sum / point3D.Track().Length();
     count += point3D.Track().Length();
-    max_point_difference =
-        std::max(max_point_difference,
-                 std::abs(point_sum / point3D.Track().Length() -
-                          point3D.Error()));
+    max_point_difference = std::max(
+        max_point_difference,
+        std::abs(point_sum / point3D.Track().Length() - point3D.Error()));
   }
   const double recomputed =
       model.NumPoints3D() > 0 ? sum_of_point_means / model.NumPoints3D() : 0;

@@ -139,8 +139,7 @@ TEST(DatabaseExportTest, WritesTheRigToMapMatchesOfTheInlierCorrespondences) {
                                 static_cast<int64_t>(match.point2D_idx2) + 1 &&
                             image.correspondences[k].point2D == keypoint);
         }
-        EXPECT_TRUE(found) << image.name << " keypoint "
-                           << match.point2D_idx1;
+        EXPECT_TRUE(found) << image.name << " keypoint " << match.point2D_idx1;
       }
     }
   }
@@ -191,10 +190,9 @@ TEST(DatabaseExportTest, Colmap38PointTriangulatorTriangulatesFromRigMatches) {
       scene.dataset, scene.calibration, &summary, &error))
       << error;
   CalibrationSummary calibration_summary;
-  ASSERT_TRUE(WriteRigOutput(folder.File("calibration"), scene.map,
-                             scene.dataset, scene.calibration, {},
-                             calibration_summary, RigOutputOptions(), nullptr,
-                             &error))
+  ASSERT_TRUE(WriteRigOutput(
+      folder.File("calibration"), scene.map, scene.dataset, scene.calibration,
+      {}, calibration_summary, RigOutputOptions(), nullptr, &error))
       << error;
   std::filesystem::create_directory(folder.File("triangulated"));
   // The README's recipe: the points are re-triangulated from the database's

@@ -44,12 +44,11 @@ SyntheticRig MakeRig(double noise_px, double map_point_noise,
     }
     for (RigImage& image : rig.dataset.images) {
       image.correspondences.erase(
-          std::remove_if(image.correspondences.begin(),
-                         image.correspondences.end(),
-                         [&](const Correspondence& correspondence) {
-                           return observed.count(correspondence.point3D_id) ==
-                                  0;
-                         }),
+          std::remove_if(
+              image.correspondences.begin(), image.correspondences.end(),
+              [&](const Correspondence& correspondence) {
+                return observed.count(correspondence.point3D_id) == 0;
+              }),
           image.correspondences.end());
     }
   }
@@ -66,10 +65,10 @@ RigCalibration PerturbedStart(const SyntheticRig& rig) {
     const Eigen::Vector3d axis =
         Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng))
             .normalized();
-    return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * M_PI / 180,
-                                                        axis)) *
-                       pose.rotation,
-                   pose.translation + 0.01 * axis);
+    return Rigid3d(
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * M_PI / 180, axis)) *
+            pose.rotation,
+        pose.translation + 0.01 * axis);
   };
   RigCalibration start;
   start.cameras = rig.truth.cameras;
@@ -113,29 +112,27 @@ double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
 Errors Compare(const SyntheticRig& rig, const RigCalibration& estimate) {
   Errors errors;
   for (size_t c = 0; c < rig.truth.cameras.size(); ++c) {
-    errors.rotation_deg =
-        std::max(errors.rotation_deg, AngleDeg(estimate.cam_from_rig[c].rotation,
-                                               rig.truth.cam_from_rig[c].rotation));
-    errors.center = std::max(errors.center,
-                             (estimate.cam_from_rig[c].Center() -
-                              rig.truth.cam_from_rig[c].Center())
-                                 .norm());
+    errors.rotation_deg = std::max(
+        errors.rotation_deg, AngleDeg(estimate.cam_from_rig[c].rotation,
+                                      rig.truth.cam_from_rig[c].rotation));
+    errors.center = std::max(errors.center, (estimate.cam_from_rig[c].Center() -
+                                             rig.truth.cam_from_rig[c].Center())
+                                                .norm());
     for (int k : {0, 1}) {
-      errors.focal_relative =
-          std::max(errors.focal_relative,
-                   std::abs(estimate.cameras[c].Params()[k] /
-                                rig.truth.cameras[c].Params()[k] -
-                            1));
+      errors.focal_relative = std::max(
+          errors.focal_relative, std::abs(estimate.cameras[c].Params()[k] /
+                                              rig.truth.cameras[c].Params()[k] -
+                                          1));
     }
   }
   for (size_t j = 0; j < rig.truth.rig_from_world.size(); ++j) {
     errors.rotation_deg = std::max(
         errors.rotation_deg, AngleDeg(estimate.rig_from_world[j]->rotation,
                                       rig.truth.rig_from_world[j].rotation));
-    errors.center = std::max(errors.center,
-                             (estimate.rig_from_world[j]->Center() -
-                              rig.truth.rig_from_world[j].Center())
-                                 .norm());
+    errors.center =
+        std::max(errors.center, (estimate.rig_from_world[j]->Center() -
+                                 rig.truth.rig_from_world[j].Center())
+                                    .norm());
   }
   std::vector<double> point_errors;
   for (const auto& [point3D_id, point] : estimate.refined_points3D) {
@@ -148,10 +145,10 @@ Errors Compare(const SyntheticRig& rig, const RigCalibration& estimate) {
     errors.point = point_errors[point_errors.size() / 2];
   }
   for (size_t i = 0; i < estimate.map_cam_from_world.size(); ++i) {
-    errors.map_center = std::max(errors.map_center,
-                                 (estimate.map_cam_from_world[i].Center() -
-                                  rig.true_map_cam_from_world[i].Center())
-                                     .norm());
+    errors.map_center =
+        std::max(errors.map_center, (estimate.map_cam_from_world[i].Center() -
+                                     rig.true_map_cam_from_world[i].Center())
+                                        .norm());
   }
   return errors;
 }
@@ -162,11 +159,10 @@ void Print(const char* label, const Errors& e,
       "%s: rotation %.3g deg, center %.3g, focal %.3g, point %.3g, map "
       "center %.3g; rig rms %.3g -> %.3g px (%d), map rms %.3g -> %.3g px "
       "(%d, %d rejected), %.2f s\n",
-      label, e.rotation_deg, e.center, e.focal_relative, e.point,
-      e.map_center, summary.initial_rms_px, summary.final_rms_px,
-      summary.num_residuals, summary.map_initial_rms_px,
-      summary.map_final_rms_px, summary.num_map_residuals,
-      summary.num_map_outliers, summary.seconds);
+      label, e.rotation_deg, e.center, e.focal_relative, e.point, e.map_center,
+      summary.initial_rms_px, summary.final_rms_px, summary.num_residuals,
+      summary.map_initial_rms_px, summary.map_final_rms_px,
+      summary.num_map_residuals, summary.num_map_outliers, summary.seconds);
 }
 
 FinalBundleAdjustmentOptions MapOptions() {
@@ -177,7 +173,8 @@ FinalBundleAdjustmentOptions MapOptions() {
   return options;
 }
 
-TEST(FinalBundleAdjusterMapImagesTest, ExactMapObservationsCorrectTheMapPoints) {
+TEST(FinalBundleAdjusterMapImagesTest,
+     ExactMapObservationsCorrectTheMapPoints) {
   // The map points are 3 cm off, every observation is exact: the map
   // images' observations (from their fixed true poses) put every refined
   // point back at the truth, and the rig with it.
@@ -288,9 +285,10 @@ TEST(FinalBundleAdjusterMapImagesTest, BadMapObservationsAreRejected) {
       num_wrongly_rejected += !corrupted[i][k] && rejected ? 1 : 0;
     }
   }
-  std::printf("%d map observations of refined points, %d bad ones kept, %d "
-              "good ones rejected\n",
-              num_in_problem, num_missed, num_wrongly_rejected);
+  std::printf(
+      "%d map observations of refined points, %d bad ones kept, %d "
+      "good ones rejected\n",
+      num_in_problem, num_missed, num_wrongly_rejected);
   EXPECT_EQ(num_missed, 0);
   EXPECT_LE(num_wrongly_rejected, num_in_problem / 1000);
 }
