@@ -69,7 +69,7 @@ focal = max(c["focal_error_percent"] for c in cameras)
 proj = max(c["mean_projection_diff_px"] for c in cameras)
 ba = s["timings_s"].get("Final bundle adjustment", float("nan"))
 m = s.get("map_images") or {}
-rms = re.findall(r"RMS ([0-9.]+) -> ([0-9.]+) px over", open(log).read())
+rms = re.findall(r"^  RMS ([0-9.]+) -> ([0-9.]+) px over", open(log).read(), re.M)
 print(f"| {name} | {rot:.4f} | {center:.3f} | {focal:.4f} | {proj:.3f} | "
       f"{float(rms[-1][1]) if rms else float('nan'):.3f} | "
       f"{m.get('input_mean_error_px', float('nan')):.3f} -> "
