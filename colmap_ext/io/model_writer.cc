@@ -419,6 +419,11 @@ bool BuildRigOutputContents(const colmap::Reconstruction& map,
         rig_model.map_output_errors.num_observations;
     map_images.num_dropped_observations =
         rig_model.num_dropped_map_observations;
+  }
+  // The note only when the map images took part in the final adjustment
+  // (the JSON's map_images is there whenever there is a map).
+  if (contents->map_images && !calibration.map_cam_from_world.empty()) {
+    const MapImagesSummary& map_images = *contents->map_images;
     std::ostringstream note;
     note << "map images: mean reprojection error " << std::setprecision(3)
          << map_images.input_mean_error_px << " px in the input map, "
