@@ -52,7 +52,10 @@ struct FinalBundleAdjustmentOptions {
   // and intrinsics are held fixed and anchor the world frame and scale; a
   // point is then refined when the rig images observe it and it has at
   // least two observations in all. Pruned map observations are reported
-  // (RigCalibration::map_observation_rejected).
+  // (RigCalibration::map_observation_rejected). Without it (false), the map
+  // images take no part in the solve, but their observations of refined
+  // points are checked after it with the same rule, so that those that no
+  // longer fit are reported as rejected too.
   bool use_map_observations = true;
   // Needs refine_points and map images: the map is adjusted with the rig,
   // every map image's pose and every map point with two observations or

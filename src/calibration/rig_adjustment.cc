@@ -46,8 +46,10 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
     }
   }
   num_given_inliers_ = observations_.size();
-  if (options.refine_points && options.use_map_observations &&
-      !dataset.map_images.empty()) {
+  // Without use_map_observations the map images are still evaluated after
+  // the last solve, so that their observations that no longer fit the
+  // refined points are rejected (RejectMapOutliers).
+  if (options.refine_points && !dataset.map_images.empty()) {
     map_cameras_ = dataset.map_cameras;
     for (const MapImage& image : dataset.map_images) {
       map_cam_from_world_.push_back(ToPoseParams(image.cam_from_world));
@@ -70,6 +72,14 @@ int RigAdjustment::MapCameraSlot(const MapObservationRef& observation) const {
 
 std::vector<RigAdjustment::MapObservationRef>
 RigAdjustment::MapObservationsInProblem() const {
+  if (!options_.use_map_observations) {
+    return {};
+  }
+  return MapObservationsOfRefinedPoints();
+}
+
+std::vector<RigAdjustment::MapObservationRef>
+RigAdjustment::MapObservationsOfRefinedPoints() const {
   std::vector<MapObservationRef> in_problem;
   for (size_t i = 0; i < map_rejected_.size(); ++i) {
     const MapImage& image = dataset_.map_images[i];
@@ -188,7 +198,8 @@ void RigAdjustment::SelectRefinedPoints() {
       map_points_.emplace(correspondence.point3D_id, correspondence.point3D);
     }
   }
-  for (size_t i = 0; i < map_rejected_.size(); ++i) {
+  for (size_t i = 0; options_.use_map_observations && i < map_rejected_.size();
+       ++i) {
     const MapImage& image = dataset_.map_images[i];
     for (size_t k = 0; k < image.observations.size(); ++k) {
       const int64_t point3D_id = image.observations[k].point3D_id;

@@ -95,7 +95,9 @@ class RigAdjustment {
       const MapObservationRef& observation) const;
   // Pruning thresholds are per rig camera, then per map camera.
   int MapCameraSlot(const MapObservationRef& observation) const;
-  // The current map observations of refined points.
+  // The current map observations of refined points, and those that take
+  // part in the problem (none without use_map_observations).
+  std::vector<MapObservationRef> MapObservationsOfRefinedPoints() const;
   std::vector<MapObservationRef> MapObservationsInProblem() const;
   // The refined position of the observed point, else its map position.
   const Eigen::Vector3d& PointOf(const Correspondence& correspondence) const;
@@ -127,7 +129,7 @@ class RigAdjustment {
   std::vector<bool> has_rig_pose_;
   std::vector<Observation> observations_;
   size_t num_given_inliers_ = 0;
-  // The map images (empty unless refine_points and use_map_observations):
+  // The map images (empty unless refine_points and map images):
   // intrinsics, poses, per observation whether it was rejected.
   std::vector<colmap::Camera> map_cameras_;
   std::vector<PoseParams> map_cam_from_world_;

@@ -64,7 +64,7 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
 
 size_t RigAdjustment::RejectMapOutliers() {
   const std::vector<MapObservationRef> map_observations =
-      MapObservationsInProblem();
+      MapObservationsOfRefinedPoints();
   std::vector<std::pair<int, ObservationError>> errors;
   errors.reserve(map_observations.size());
   for (const MapObservationRef& observation : map_observations) {
