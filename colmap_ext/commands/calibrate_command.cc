@@ -9,6 +9,7 @@
 #include "colmap_ext/commands/calibration_report.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/database_export.h"
 #include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/model_writer.h"
 
@@ -70,6 +71,7 @@ int RunCalibrate(int argc, char** argv) {
           : LoadFromDatabase(options, map, &dataset, &layout, &error,
                              &known_rig);
   if (!loaded) return PrintError(error);
+  AddMapImages(map, &dataset);
 
   RigCalibration calibration;
   PipelineReport report;
@@ -88,6 +90,25 @@ int RunCalibrate(int argc, char** argv) {
                       error);
   }
   PrintResult(dataset, report, summary, notes);
+  if (!options.export_database.empty()) {
+    DatabaseExportSummary exported;
+    if (!ExportDatabaseWithRigMatches(options.database_path,
+                                      options.export_database, map, dataset,
+                                      calibration, &exported, &error)) {
+      return PrintError("exporting the database failed: " + error);
+    }
+    std::cout << "\nDatabase for COLMAP in " << options.export_database << ": "
+              << exported.num_matches << " matches of "
+              << exported.num_rig_images << " rig images to the map images ("
+              << exported.num_image_pairs << " image pairs), "
+              << exported.num_cameras_updated
+              << " rig cameras with the calibrated intrinsics";
+    if (exported.num_unmatched_rows > 0) {
+      std::cout << "; " << exported.num_unmatched_rows
+                << " correspondences have no keypoint in the database";
+    }
+    std::cout << std::endl;
+  }
   std::cout << "\nOutputs in " << options.output_path
             << ": COLMAP model (open with `colmap gui --import_path` or "
                "`colmap model_analyzer --path`), rigs/frames and "

@@ -1,6 +1,7 @@
 #include "colmap_ext/commands/calibrate_options.h"
 
 #include <boost/algorithm/string.hpp>
+#include <boost/filesystem.hpp>
 
 #include "colmap_ext/commands/command_options.h"
 
@@ -66,6 +67,23 @@ void AddRigCalibratorOptions(po::options_description* description,
             "twice in the final bundle adjustment (the result is then "
             "aligned back to the map by a similarity); 0: keep the map "
             "points fixed");
+  AddOption(description, "RigCalibrator.map_observations", &o->map_observations,
+            "with refine_points and a map (--input_path): the map images' "
+            "observations of the refined points are residuals too, the map "
+            "images' poses and cameras held fixed");
+  AddOption(description, "RigCalibrator.refine_map", &o->refine_map,
+            "adjust every map image's pose and every map point with the rig "
+            "(with refine_points, map_observations and a map; the result is "
+            "aligned to the input map's camera centres by a similarity); 0: "
+            "the map images' poses stay fixed");
+  AddOption(description, "RigCalibrator.refine_map_intrinsics",
+            &o->refine_map_intrinsics,
+            "with refine_map: also adjust the map cameras' intrinsics");
+  AddUnsetOption(description, "RigCalibrator.export_database",
+                 &o->export_database,
+                 "write a copy of --database_path with the rig images' "
+                 "verified matches to the map images (for COLMAP's "
+                 "point_triangulator, mapper, bundle_adjuster); a new file");
   AddOption(description, "RigCalibrator.radial_max_error",
             &o->radial_max_error_px,
             "inlier threshold of the 1D radial stages (pixels)");
@@ -169,6 +187,37 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
   pipeline->radial_bundle_adjustment.loss_scale_px = options->loss_scale_px;
   pipeline->final_bundle_adjustment.loss_scale_px = options->loss_scale_px;
   pipeline->final_bundle_adjustment.refine_points = options->refine_points;
+  pipeline->final_bundle_adjustment.use_map_observations =
+      options->map_observations;
+  // The map is adjusted with the rig only where there is one to adjust.
+  pipeline->final_bundle_adjustment.refine_map =
+      options->refine_map && options->refine_points &&
+      options->map_observations && !options->input_path.empty();
+  pipeline->final_bundle_adjustment.refine_map_intrinsics =
+      pipeline->final_bundle_adjustment.refine_map &&
+      options->refine_map_intrinsics;
+  if (options->refine_map_intrinsics && !options->refine_map) {
+    *error =
+        "--RigCalibrator.refine_map_intrinsics 1 needs "
+        "--RigCalibrator.refine_map 1";
+    return false;
+  }
+  if (!options->export_database.empty() &&
+      (options->database_path.empty() || options->input_path.empty())) {
+    *error =
+        "--RigCalibrator.export_database needs the map's database "
+        "(--database_path) and model (--input_path)";
+    return false;
+  }
+  if (!options->export_database.empty()) {
+    // Checked before the calibration, so that a bad path costs no run.
+    boost::system::error_code code;
+    if (boost::filesystem::exists(options->export_database, code)) {
+      *error = "--RigCalibrator.export_database " + options->export_database +
+               " exists; give the path of a new file (it never overwrites)";
+      return false;
+    }
+  }
   return true;
 }
 

@@ -488,4 +488,36 @@ bool LoadFromCorrespondences(const CalibrateOptions& options,
   return true;
 }
 
+void AddMapImages(const colmap::Reconstruction& map, RigDataset* dataset) {
+  std::map<colmap::camera_t, int> camera_index;
+  for (const colmap::image_t image_id : map.RegImageIds()) {
+    const colmap::Image& image = map.Image(image_id);
+    const auto [it, inserted] = camera_index.emplace(
+        image.CameraId(), static_cast<int>(dataset->map_cameras.size()));
+    if (inserted) {
+      dataset->map_cameras.push_back(map.Camera(image.CameraId()));
+    }
+    MapImage map_image;
+    map_image.name = image.Name();
+    map_image.image_id = image_id;
+    map_image.camera_index = it->second;
+    map_image.cam_from_world =
+        Rigid3d(Eigen::Quaterniond(image.Qvec()(0), image.Qvec()(1),
+                                   image.Qvec()(2), image.Qvec()(3))
+                    .normalized(),
+                image.Tvec());
+    for (colmap::point2D_t k = 0; k < image.NumPoints2D(); ++k) {
+      const colmap::Point2D& point2D = image.Point2D(k);
+      if (point2D.HasPoint3D() && map.ExistsPoint3D(point2D.Point3DId())) {
+        map_image.observations.push_back(
+            {point2D.XY(), static_cast<int64_t>(point2D.Point3DId()), k});
+      }
+    }
+    dataset->map_images.push_back(std::move(map_image));
+  }
+  for (const auto& [point3D_id, point3D] : map.Points3D()) {
+    dataset->map_points3D[static_cast<int64_t>(point3D_id)] = point3D.XYZ();
+  }
+}
+
 }  // namespace rig_calibrator

@@ -33,4 +33,9 @@ bool LoadFromCorrespondences(const CalibrateOptions& options,
                              RigDataset* dataset, RigLayout* layout,
                              std::string* error);
 
+// Adds the registered images of `map` with their cameras, poses and
+// observations of map points, and every map point, to the dataset (for the
+// final bundle adjustment's map observations).
+void AddMapImages(const colmap::Reconstruction& map, RigDataset* dataset);
+
 }  // namespace rig_calibrator

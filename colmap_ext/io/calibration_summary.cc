@@ -168,6 +168,17 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     }
     root["known_rig"] = known;
   }
+  if (summary.map_images) {
+    const MapImagesSummary& map = *summary.map_images;
+    root["map_images"] = {
+        {"input_mean_error_px", Number(map.input_mean_error_px)},
+        {"output_mean_error_px", Number(map.output_mean_error_px)},
+        {"input_max_error_px", Number(map.input_max_error_px)},
+        {"output_max_error_px", Number(map.output_max_error_px)},
+        {"num_input_observations", map.num_input_observations},
+        {"num_output_observations", map.num_output_observations},
+        {"num_dropped_observations", map.num_dropped_observations}};
+  }
   root["diagnostics"] = summary.diagnostics;
   return WriteJson(path, root, error);
 }

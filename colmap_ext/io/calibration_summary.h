@@ -56,6 +56,15 @@ struct KnownPoseComparison {
   double known_translation_norm = 0;
 };
 
+// The map images' observations, reprojection errors recomputed in the input
+// map and in the output model (pixels).
+struct MapImagesSummary {
+  double input_mean_error_px = 0, output_mean_error_px = 0;
+  double input_max_error_px = 0, output_max_error_px = 0;
+  int64_t num_input_observations = 0, num_output_observations = 0;
+  int64_t num_dropped_observations = 0;
+};
+
 struct CalibrationSummary {
   // "1dr", "rd_ra", "rd", "known", "known_refine", "known_ra"
   std::string method;
@@ -75,6 +84,7 @@ struct CalibrationSummary {
   std::vector<std::string> diagnostics;  // warnings and notes, in order
   // Stage, wall seconds: written by WriteTimingsJson only.
   std::vector<std::pair<std::string, double>> timings_s;
+  std::optional<MapImagesSummary> map_images;  // with a map
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -4,7 +4,10 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -12,6 +15,7 @@
 #include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/map_reader.h"
+#include "colmap_ext/io/model_errors.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
 
@@ -224,6 +228,45 @@ bool AddRigFrames(const colmap::Reconstruction& map, const RigDataset& dataset,
   return true;
 }
 
+// The final adjustment's map results (adjusted map poses and intrinsics,
+// rejected map observations), then every point's error recomputed, so that
+// the model's stored errors are its own (model_errors.h). Observations behind
+// their camera are dropped (COLMAP would count them as infinite).
+void ApplyMapResults(const RigDataset& dataset,
+                     const RigCalibration& calibration,
+                     colmap::Reconstruction* model,
+                     int64_t* num_dropped_map_observations) {
+  *num_dropped_map_observations = 0;
+  if (!calibration.map_cam_from_world.empty()) {
+    for (const colmap::Camera& camera : calibration.map_cameras) {
+      if (model->ExistsCamera(camera.CameraId())) {
+        model->Camera(camera.CameraId()).SetParams(camera.Params());
+      }
+    }
+    for (size_t i = 0; i < dataset.map_images.size(); ++i) {
+      const MapImage& map_image = dataset.map_images[i];
+      const colmap::image_t image_id =
+          static_cast<colmap::image_t>(map_image.image_id);
+      if (!model->ExistsImage(image_id)) continue;
+      colmap::Image& image = model->Image(image_id);
+      image.SetQvec(calibration.map_cam_from_world[i].Qvec());
+      image.SetTvec(calibration.map_cam_from_world[i].translation);
+      for (size_t k = 0; k < map_image.observations.size(); ++k) {
+        const colmap::point2D_t point2D_idx =
+            map_image.observations[k].point2D_idx;
+        if (calibration.map_observation_rejected[i][k] &&
+            point2D_idx < image.NumPoints2D() &&
+            image.Point2D(point2D_idx).HasPoint3D()) {
+          model->DeleteObservation(image_id, point2D_idx);
+          ++*num_dropped_map_observations;
+        }
+      }
+    }
+  }
+  model->FilterObservationsWithNegativeDepth();
+  RecomputePointErrors(model);
+}
+
 }  // namespace
 
 bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
@@ -245,8 +288,22 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
   }
   AddRigCameras(dataset, calibration, std::move(cameras), max_camera_id,
                 &rig_model->model, &rig_model->rig);
-  return AddRigFrames(map, dataset, calibration, max_image_id, rig_model,
-                      error);
+  if (!AddRigFrames(map, dataset, calibration, max_image_id, rig_model,
+                    error)) {
+    return false;
+  }
+  ApplyMapResults(dataset, calibration, &rig_model->model,
+                  &rig_model->num_dropped_map_observations);
+  std::unordered_set<colmap::image_t> map_image_ids;
+  for (const colmap::image_t image_id : map.RegImageIds()) {
+    map_image_ids.insert(image_id);
+  }
+  if (!map_image_ids.empty()) {
+    rig_model->map_input_errors = ComputeReprojectionStats(map, map_image_ids);
+    rig_model->map_output_errors =
+        ComputeReprojectionStats(rig_model->model, map_image_ids);
+  }
+  return true;
 }
 
 namespace {
@@ -312,6 +369,7 @@ struct RigOutputContents {
   bool reference_calibrated = false;
   std::vector<std::string> notes;
   std::vector<CameraRecord> newer_model_map_cameras;
+  std::optional<MapImagesSummary> map_images;
 };
 
 bool BuildRigOutputContents(const colmap::Reconstruction& map,
@@ -350,6 +408,35 @@ bool BuildRigOutputContents(const colmap::Reconstruction& map,
       rig.cameras[rig.reference_camera].camera.has_value();
   contents->notes =
       RigConfigNotes(contents->rig_model, rig, contents->reference_calibrated);
+  const RigModel& rig_model = contents->rig_model;
+  if (rig_model.map_input_errors.num_observations > 0) {
+    MapImagesSummary& map_images = contents->map_images.emplace();
+    map_images.input_mean_error_px = rig_model.map_input_errors.mean_px;
+    map_images.output_mean_error_px = rig_model.map_output_errors.mean_px;
+    map_images.input_max_error_px = rig_model.map_input_errors.max_px;
+    map_images.output_max_error_px = rig_model.map_output_errors.max_px;
+    map_images.num_input_observations =
+        rig_model.map_input_errors.num_observations;
+    map_images.num_output_observations =
+        rig_model.map_output_errors.num_observations;
+    map_images.num_dropped_observations =
+        rig_model.num_dropped_map_observations;
+  }
+  // The note only when the map images took part in the final adjustment
+  // (the JSON's map_images is there whenever there is a map).
+  if (contents->map_images && !calibration.map_cam_from_world.empty()) {
+    const MapImagesSummary& map_images = *contents->map_images;
+    std::ostringstream note;
+    note << "map images: mean reprojection error " << std::setprecision(3)
+         << map_images.input_mean_error_px << " px in the input map, "
+         << map_images.output_mean_error_px << " px in the output model (max "
+         << map_images.input_max_error_px << " -> "
+         << map_images.output_max_error_px << " px); "
+         << map_images.num_dropped_observations
+         << " map observations that no longer fit their refined points "
+            "dropped";
+    contents->notes.push_back(note.str());
+  }
   return true;
 }
 
@@ -389,6 +476,7 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
                               " is not written: " + camchain_error);
   }
   CalibrationSummary final_summary = summary;
+  final_summary.map_images = contents->map_images;
   final_summary.diagnostics.insert(final_summary.diagnostics.end(),
                                    contents->notes.begin(),
                                    contents->notes.end());

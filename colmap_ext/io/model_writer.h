@@ -22,6 +22,7 @@
 
 #include "colmap_ext/io/calibration_summary.h"
 #include "colmap_ext/io/camera_records_io.h"
+#include "colmap_ext/io/model_errors.h"
 #include "colmap_ext/io/rigs_frames_io.h"
 #include "src/calibration/rig_dataset.h"
 
@@ -42,6 +43,10 @@ struct RigModel {
   ModelRig rig;
   // Per dataset image: its image id, or kInvalidImageId if not registered.
   std::vector<colmap::image_t> image_ids;
+  // The map images' observations: errors recomputed in the input map and in
+  // `model`, and the observations the final adjustment rejected (dropped).
+  ReprojectionStats map_input_errors, map_output_errors;
+  int64_t num_dropped_map_observations = 0;
 };
 
 // The map (with the refined points of `calibration`, if any) plus:
@@ -52,7 +57,11 @@ struct RigModel {
 //   image id = (the map's largest image id) + 1 + (its dataset index);
 // * as the image's points2D all its correspondences' 2D points; those that are
 //   inliers and whose point3D_id is a map point observe it (one observation
-//   per map point and image).
+//   per map point and image);
+// * the map images at the calibration's map poses and intrinsics (if it has
+//   map results), without the map observations it rejected;
+// * every point's error recomputed from the final model (model_errors.h),
+//   observations behind their camera dropped.
 // Fails, leaving `rig_model` unspecified, if the calibration does not match
 // the dataset, intrinsics are invalid, a refined point or a rig image name is
 // already in the map, or the ids overflow.

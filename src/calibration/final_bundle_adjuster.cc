@@ -28,6 +28,13 @@ bool CheckInput(const FinalBundleAdjustmentOptions& options,
                   "iterations, outlier thresholds or pruning rounds)";
     return false;
   }
+  if (options.refine_map &&
+      (!options.refine_points || !options.use_map_observations ||
+       dataset.map_images.empty())) {
+    LOG(ERROR) << "Final bundle adjustment: refining the map needs the map "
+                  "images and refine_points with use_map_observations";
+    return false;
+  }
   for (size_t camera = 0; camera < dataset.cameras.size(); ++camera) {
     const colmap::Camera& intrinsics = calibration.cameras[camera];
     if (calibration.camera_calibrated[camera] &&
@@ -52,6 +59,8 @@ bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
       return false;
     }
     result->num_residuals = static_cast<int>(adjustment->NumObservations());
+    result->num_map_residuals =
+        static_cast<int>(adjustment->NumMapObservationsInProblem());
     result->num_iterations += ceres_summary.num_successful_steps +
                               ceres_summary.num_unsuccessful_steps;
     result->ceres_report = ceres_summary.BriefReport();
@@ -90,24 +99,34 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& options,
   }
   FinalBundleAdjustmentSummary result;
   result.initial_rms_px = adjustment.RmsError();
+  result.map_initial_rms_px = adjustment.MapRmsError();
   if (!SolveWithPruning(options, &adjustment, &result)) {
     return false;
   }
+  adjustment.RejectMapOutliers();
   result.final_rms_px = adjustment.RmsError();
+  result.map_final_rms_px = adjustment.MapRmsError();
   result.num_outliers = static_cast<int>(adjustment.NumRejected());
+  result.num_map_outliers = static_cast<int>(adjustment.NumMapRejected());
   adjustment.WriteTo(calibration);
-  // The gauge (map_anchoring.h): fixed points anchor the world frame; with
-  // none, the solution is moved back onto the map.
+  // The gauge (map_anchoring.h): fixed points or map poses anchor the world
+  // frame; with none, the solution is moved back onto the map.
   if (options.refine_points && !adjustment.HasFixedPoints()) {
-    AnchorRefinedPointsToMap(dataset, calibration);
+    if (options.refine_map) {
+      AnchorMapImagesToMap(dataset, calibration);
+    } else {
+      AnchorRefinedPointsToMap(dataset, calibration);
+    }
   }
   result.seconds = std::chrono::duration<double>(
                        std::chrono::steady_clock::now() - start_time)
                        .count();
   VLOG(1) << "Final bundle adjustment: RMS " << result.initial_rms_px << " -> "
           << result.final_rms_px << " px over " << result.num_residuals
-          << " observations, " << result.num_outliers << " outliers, "
-          << result.seconds << " s";
+          << " observations, " << result.num_outliers << " outliers; map RMS "
+          << result.map_initial_rms_px << " -> " << result.map_final_rms_px
+          << " px over " << result.num_map_residuals << " observations, "
+          << result.num_map_outliers << " outliers, " << result.seconds << " s";
   if (summary != nullptr) {
     *summary = result;
   }

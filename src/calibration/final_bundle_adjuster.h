@@ -45,6 +45,26 @@ struct FinalBundleAdjustmentOptions {
   // by the similarity that best aligns the refined points with their map
   // positions, which changes no reprojection error (map_anchoring.h).
   bool refine_points = false;
+  // With refine_points and map images in the dataset: the map images'
+  // observations of the refined points are residuals as well, with the same
+  // robust loss and outlier pruning (thresholds per map camera), so that a
+  // point's position uses all the images that see it. The map images' poses
+  // and intrinsics are held fixed and anchor the world frame and scale; a
+  // point is then refined when the rig images observe it and it has at
+  // least two observations in all. Pruned map observations are reported
+  // (RigCalibration::map_observation_rejected). Without it (false), the map
+  // images take no part in the solve, but their observations of refined
+  // points are checked after it with the same rule, so that those that no
+  // longer fit are reported as rejected too.
+  bool use_map_observations = true;
+  // Needs refine_points and map images: the map is adjusted with the rig,
+  // every map image's pose and every map point with two observations or
+  // more (refine_map_intrinsics: the map cameras' focal lengths, principal
+  // points and distortion too). Nothing then holds the gauge, and the
+  // solution is moved onto the map by the similarity that best aligns the
+  // adjusted map camera centres with the input ones (map_anchoring.h).
+  bool refine_map = false;
+  bool refine_map_intrinsics = false;
   // Outlier pruning after a first solve, then solve again. An observation is
   // an outlier if
   //  - its reprojection error exceeds max(min_outlier_error_px,
@@ -78,6 +98,10 @@ struct FinalBundleAdjustmentSummary {
   // iterations summed over all solves; wall time of AdjustRig.
   int num_residuals = 0, num_outliers = 0, num_iterations = 0;
   double seconds = 0;
+  // The map images' observations in the problem (of refined points): count
+  // in the last solve, rejected, RMS at the initial estimate and the result.
+  int num_map_residuals = 0, num_map_outliers = 0;
+  double map_initial_rms_px = 0, map_final_rms_px = 0;
   std::string ceres_report;  // Ceres BriefReport of the last solve
 };
 
@@ -86,7 +110,9 @@ struct FinalBundleAdjustmentSummary {
 // rig pose and whose camera is calibrated. Updates calibration->cameras,
 // cam_from_rig, rig_from_world, images[i].inlier_mask / num_inliers / rms_px /
 // used (images outside the adjustment get an all-zero mask and used = false)
-// and, with refine_points, refined_points3D. On bad input (a dataset that
+// and, with refine_points, refined_points3D, and, with map images in the
+// dataset, map_cameras, map_cam_from_world and map_observation_rejected. On
+// bad input (a dataset that
 // ValidateDataset rejects, inconsistent sizes, unknown camera model, no
 // usable observation) or a Ceres failure it
 // logs the reason, leaves `calibration` unchanged and returns false.

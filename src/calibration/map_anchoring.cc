@@ -5,15 +5,50 @@
 #include <unordered_map>
 
 namespace rig_calibrator {
+namespace {
+
+// Applies the similarity X' = s R X + t (similarity = [s R, t]) to the
+// refined points, rig poses, cam_from_rig translations and map image poses,
+// leaving every projection unchanged (see the header).
+void ApplySimilarity(const Eigen::Matrix4d& similarity,
+                     RigCalibration* calibration) {
+  const Eigen::Matrix3d scaled_rotation = similarity.topLeftCorner<3, 3>();
+  const double scale = std::cbrt(scaled_rotation.determinant());
+  const Eigen::Matrix3d rotation = scaled_rotation / scale;
+  const Eigen::Vector3d translation = similarity.topRightCorner<3, 1>();
+  for (auto& [point3D_id, point] : calibration->refined_points3D) {
+    point = scaled_rotation * point + translation;
+  }
+  const auto move_pose = [&](Rigid3d* x_from_world) {
+    const Eigen::Matrix3d new_rotation =
+        x_from_world->RotationMatrix() * rotation.transpose();
+    *x_from_world = Rigid3d(new_rotation, scale * x_from_world->translation -
+                                              new_rotation * translation);
+  };
+  for (std::optional<Rigid3d>& rig_from_world : calibration->rig_from_world) {
+    if (rig_from_world) {
+      move_pose(&*rig_from_world);
+    }
+  }
+  for (Rigid3d& cam_from_world : calibration->map_cam_from_world) {
+    move_pose(&cam_from_world);
+  }
+  for (Rigid3d& cam_from_rig : calibration->cam_from_rig) {
+    cam_from_rig.translation *= scale;
+  }
+}
+
+}  // namespace
 
 bool AnchorRefinedPointsToMap(const RigDataset& dataset,
                               RigCalibration* calibration) {
-  std::unordered_map<int64_t, Eigen::Vector3d>& refined_points =
+  const std::unordered_map<int64_t, Eigen::Vector3d>& refined_points =
       calibration->refined_points3D;
   if (refined_points.size() < 3) {
     return false;
   }
-  std::unordered_map<int64_t, Eigen::Vector3d> map_points;
+  std::unordered_map<int64_t, Eigen::Vector3d> map_points =
+      dataset.map_points3D;
   for (const RigImage& image : dataset.images) {
     for (const Correspondence& correspondence : image.correspondences) {
       if (refined_points.count(correspondence.point3D_id) > 0) {
@@ -29,26 +64,23 @@ bool AnchorRefinedPointsToMap(const RigDataset& dataset,
     mapped.col(column) = map_points.at(point3D_id);
     ++column;
   }
-  const Eigen::Matrix4d similarity = Eigen::umeyama(refined, mapped, true);
-  const Eigen::Matrix3d scaled_rotation = similarity.topLeftCorner<3, 3>();
-  const double scale = std::cbrt(scaled_rotation.determinant());
-  const Eigen::Matrix3d rotation = scaled_rotation / scale;
-  const Eigen::Vector3d translation = similarity.topRightCorner<3, 1>();
-  for (auto& [point3D_id, point] : refined_points) {
-    point = scaled_rotation * point + translation;
+  ApplySimilarity(Eigen::umeyama(refined, mapped, true), calibration);
+  return true;
+}
+
+bool AnchorMapImagesToMap(const RigDataset& dataset,
+                          RigCalibration* calibration) {
+  const size_t num_images = dataset.map_images.size();
+  if (num_images < 3 || calibration->map_cam_from_world.size() != num_images) {
+    return false;
   }
-  for (std::optional<Rigid3d>& rig_from_world : calibration->rig_from_world) {
-    if (!rig_from_world) {
-      continue;
-    }
-    const Eigen::Matrix3d new_rotation =
-        rig_from_world->RotationMatrix() * rotation.transpose();
-    rig_from_world = Rigid3d(new_rotation, scale * rig_from_world->translation -
-                                               new_rotation * translation);
+  Eigen::Matrix3Xd adjusted(3, num_images);
+  Eigen::Matrix3Xd mapped(3, num_images);
+  for (size_t i = 0; i < num_images; ++i) {
+    adjusted.col(i) = calibration->map_cam_from_world[i].Center();
+    mapped.col(i) = dataset.map_images[i].cam_from_world.Center();
   }
-  for (Rigid3d& cam_from_rig : calibration->cam_from_rig) {
-    cam_from_rig.translation *= scale;
-  }
+  ApplySimilarity(Eigen::umeyama(adjusted, mapped, true), calibration);
   return true;
 }
 

@@ -281,6 +281,14 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
               << summary.final_rms_px << " px over " << summary.num_residuals
               << " residuals, " << summary.num_outliers << " outliers removed, "
               << summary.num_iterations << " iterations" << std::endl;
+    if (summary.num_map_residuals > 0) {
+      std::cout << "  map images: RMS " << summary.map_initial_rms_px << " -> "
+                << summary.map_final_rms_px << " px over "
+                << summary.num_map_residuals
+                << " observations of refined "
+                   "points, "
+                << summary.num_map_outliers << " rejected" << std::endl;
+    }
   }
   return true;
 }

@@ -46,6 +46,55 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
     }
   }
   num_given_inliers_ = observations_.size();
+  // Without use_map_observations the map images are still evaluated after
+  // the last solve, so that their observations that no longer fit the
+  // refined points are rejected (RejectMapOutliers).
+  if (options.refine_points && !dataset.map_images.empty()) {
+    map_cameras_ = dataset.map_cameras;
+    for (const MapImage& image : dataset.map_images) {
+      map_cam_from_world_.push_back(ToPoseParams(image.cam_from_world));
+      map_rejected_.emplace_back(image.observations.size(), 0);
+    }
+    map_points_ = dataset.map_points3D;
+  }
+}
+
+const MapObservation& RigAdjustment::MapObservationOf(
+    const MapObservationRef& observation) const {
+  return dataset_.map_images[observation.image]
+      .observations[observation.observation];
+}
+
+int RigAdjustment::MapCameraSlot(const MapObservationRef& observation) const {
+  return static_cast<int>(cameras_.size()) +
+         dataset_.map_images[observation.image].camera_index;
+}
+
+std::vector<RigAdjustment::MapObservationRef>
+RigAdjustment::MapObservationsInProblem() const {
+  if (!options_.use_map_observations) {
+    return {};
+  }
+  return MapObservationsOfRefinedPoints();
+}
+
+std::vector<RigAdjustment::MapObservationRef>
+RigAdjustment::MapObservationsOfRefinedPoints() const {
+  std::vector<MapObservationRef> in_problem;
+  for (size_t i = 0; i < map_rejected_.size(); ++i) {
+    const MapImage& image = dataset_.map_images[i];
+    for (size_t k = 0; k < image.observations.size(); ++k) {
+      if (!map_rejected_[i][k] &&
+          IsPointRefined(image.observations[k].point3D_id)) {
+        in_problem.push_back({static_cast<int>(i), static_cast<int>(k)});
+      }
+    }
+  }
+  return in_problem;
+}
+
+size_t RigAdjustment::NumMapObservationsInProblem() const {
+  return MapObservationsInProblem().size();
 }
 
 const Correspondence& RigAdjustment::CorrespondenceOf(
@@ -76,12 +125,50 @@ RigAdjustment::ObservationError RigAdjustment::Evaluate(
   return error;
 }
 
+RigAdjustment::ObservationError RigAdjustment::Evaluate(
+    const MapObservationRef& observation) const {
+  const MapImage& image = dataset_.map_images[observation.image];
+  const MapObservation& map_observation = MapObservationOf(observation);
+  const Eigen::Vector3d point_in_cam =
+      FromPoseParams(map_cam_from_world_[observation.image]) *
+      PointOf(map_observation.point3D_id);
+  ObservationError error;
+  error.depth = point_in_cam.z();
+  if (error.depth > 0) {
+    error.residual = map_cameras_[image.camera_index].WorldToImage(
+                         point_in_cam.hnormalized()) -
+                     map_observation.point2D;
+  }
+  return error;
+}
+
+double RigAdjustment::MapRmsError() {
+  if (!points_selected_ && options_.refine_points) {
+    SelectRefinedPoints();
+  }
+  const std::vector<MapObservationRef> in_problem = MapObservationsInProblem();
+  double sum = 0;
+  for (const MapObservationRef& observation : in_problem) {
+    sum += Evaluate(observation).residual.squaredNorm();
+  }
+  return in_problem.empty() ? 0 : std::sqrt(sum / in_problem.size());
+}
+
 double RigAdjustment::RmsError() const {
   double sum = 0;
   for (const Observation& observation : observations_) {
     sum += Evaluate(observation).residual.squaredNorm();
   }
   return observations_.empty() ? 0 : std::sqrt(sum / observations_.size());
+}
+
+const Eigen::Vector3d& RigAdjustment::PointOf(int64_t point3D_id) const {
+  const auto it = refined_points_.find(point3D_id);
+  return it != refined_points_.end() ? it->second : map_points_.at(point3D_id);
+}
+
+bool RigAdjustment::IsPointRefined(int64_t point3D_id) const {
+  return point3D_id >= 0 && refined_points_.count(point3D_id) > 0;
 }
 
 const Eigen::Vector3d& RigAdjustment::PointOf(
@@ -101,17 +188,33 @@ bool RigAdjustment::IsPointRefined(const Correspondence& correspondence) const {
 }
 
 void RigAdjustment::SelectRefinedPoints() {
-  std::unordered_map<int64_t, int> num_observations;
+  points_selected_ = true;
+  // Per point: observations by rig images, then by map images.
+  std::unordered_map<int64_t, std::pair<int, int>> num_observations;
   for (const Observation& observation : observations_) {
     const Correspondence& correspondence = CorrespondenceOf(observation);
     if (correspondence.point3D_id >= 0) {
-      ++num_observations[correspondence.point3D_id];
+      ++num_observations[correspondence.point3D_id].first;
       map_points_.emplace(correspondence.point3D_id, correspondence.point3D);
     }
   }
+  for (size_t i = 0; options_.use_map_observations && i < map_rejected_.size();
+       ++i) {
+    const MapImage& image = dataset_.map_images[i];
+    for (size_t k = 0; k < image.observations.size(); ++k) {
+      const int64_t point3D_id = image.observations[k].point3D_id;
+      if (map_rejected_[i][k]) continue;
+      if (options_.refine_map) {
+        ++num_observations[point3D_id].second;
+      } else if (const auto it = num_observations.find(point3D_id);
+                 it != num_observations.end()) {
+        ++it->second.second;
+      }
+    }
+  }
   std::unordered_map<int64_t, Eigen::Vector3d> refined_points;
-  for (const auto& [point3D_id, count] : num_observations) {
-    if (count >= 2) {
+  for (const auto& [point3D_id, counts] : num_observations) {
+    if (counts.first + counts.second >= 2) {
       const auto it = refined_points_.find(point3D_id);
       refined_points[point3D_id] =
           it != refined_points_.end() ? it->second : map_points_.at(point3D_id);
@@ -155,6 +258,23 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
   calibration->refined_points3D.clear();
   for (const auto& [point3D_id, point] : refined_points_) {
     calibration->refined_points3D[point3D_id] = point;
+  }
+  calibration->map_cameras.clear();
+  calibration->map_cam_from_world.clear();
+  calibration->map_observation_rejected.clear();
+  if (!dataset_.map_images.empty()) {
+    calibration->map_cameras =
+        map_cameras_.empty() ? dataset_.map_cameras : map_cameras_;
+    for (size_t i = 0; i < dataset_.map_images.size(); ++i) {
+      const MapImage& image = dataset_.map_images[i];
+      calibration->map_cam_from_world.push_back(
+          map_cam_from_world_.empty() ? image.cam_from_world
+                                      : FromPoseParams(map_cam_from_world_[i]));
+      calibration->map_observation_rejected.push_back(
+          map_rejected_.empty()
+              ? std::vector<char>(image.observations.size(), 0)
+              : map_rejected_[i]);
+    }
   }
 }
 

@@ -34,22 +34,34 @@ class RigAdjustment {
                 const RigDataset& dataset, const RigCalibration& calibration);
 
   size_t NumObservations() const { return observations_.size(); }
+  // Map observations of refined points that the last solve used.
+  size_t NumMapObservationsInProblem() const;
+  size_t NumMapRejected() const { return num_map_rejected_; }
   // Given inliers removed since the construction.
   size_t NumRejected() const {
     return num_given_inliers_ - observations_.size();
   }
-  // Whether the last solve held some observed point fixed (a point without
-  // id, or seen once): such points anchor the world frame and scale.
+  // Whether the last solve held something observed fixed in the world: a
+  // point (without id, or seen once) or a map image's pose. Either anchors
+  // the world frame and scale.
   bool HasFixedPoints() const { return has_fixed_points_; }
 
-  // RMS of |r| over the current observations at the current estimate.
+  // RMS of |r| over the current rig observations at the current estimate.
   double RmsError() const;
+  // The same over the map observations of the points being refined (those
+  // selected by the last solve, or at the first call those it will select).
+  double MapRmsError();
 
   // Removes observations behind their camera or farther than
   // max_depth_factor * the median depth; with `prune_residuals` also those
   // whose error exceeds their camera's threshold (see the options). Returns
   // how many were removed.
   size_t RejectOutliers(bool prune_residuals);
+  // The map part of RejectOutliers(true) at the current estimate, without
+  // solving again: after the last solve, so that the map observations kept
+  // all fit their refined points (the rejected ones are dropped from the
+  // output model). Returns how many were rejected.
+  size_t RejectMapOutliers();
 
   // Builds the problem over the current observations and solves it. False
   // (logged) when Ceres finds no usable solution.
@@ -64,6 +76,11 @@ class RigAdjustment {
     int image = -1;
     int correspondence = -1;
   };
+  // One observation of a map image (dataset.map_images).
+  struct MapObservationRef {
+    int image = -1;
+    int observation = -1;
+  };
   // Where a point is and its residual at the current estimate.
   struct ObservationError {
     double depth = 0;  // z in the camera frame
@@ -73,19 +90,32 @@ class RigAdjustment {
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
   ObservationError Evaluate(const Observation& observation) const;
+  ObservationError Evaluate(const MapObservationRef& observation) const;
+  const MapObservation& MapObservationOf(
+      const MapObservationRef& observation) const;
+  // Pruning thresholds are per rig camera, then per map camera.
+  int MapCameraSlot(const MapObservationRef& observation) const;
+  // The current map observations of refined points, and those that take
+  // part in the problem (none without use_map_observations).
+  std::vector<MapObservationRef> MapObservationsOfRefinedPoints() const;
+  std::vector<MapObservationRef> MapObservationsInProblem() const;
   // The refined position of the observed point, else its map position.
   const Eigen::Vector3d& PointOf(const Correspondence& correspondence) const;
+  const Eigen::Vector3d& PointOf(int64_t point3D_id) const;
   bool IsPointRefined(const Correspondence& correspondence) const;
-  // The points to refine in the next solve: those with an id that the
-  // current observations see at least twice (seen once, a point has 3
-  // unknowns for 2 residuals). They keep their refined position from an
-  // earlier solve, or start at their map position.
+  bool IsPointRefined(int64_t point3D_id) const;
+  // The points to refine in the next solve: those with an id that have at
+  // least two current observations (seen once, a point has 3 unknowns for 2
+  // residuals), counting the map images' (use_map_observations) for points
+  // the rig images see and, with refine_map, every map point. They keep
+  // their refined position from an earlier solve, or start at their map
+  // position.
   void SelectRefinedPoints();
-  // Per camera, max(min_outlier_error_px, outlier_sigma_factor * sigma),
-  // sigma the robust spread of the residual components of the camera's
-  // observations in front of it.
-  std::vector<double> MaxErrorPerCamera(
-      const std::vector<ObservationError>& errors) const;
+  // Per slot (rig cameras, then map cameras), max(min_outlier_error_px,
+  // outlier_sigma_factor * sigma), sigma the robust spread of the residual
+  // components of the slot's observations in front of their camera.
+  std::vector<double> MaxErrorPerSlot(
+      const std::vector<std::pair<int, ObservationError>>& errors) const;
 
   void AddResidualBlocks(ceres::Problem* problem);
   void SetUpParameterBlocks(ceres::Problem* problem);
@@ -99,6 +129,16 @@ class RigAdjustment {
   std::vector<bool> has_rig_pose_;
   std::vector<Observation> observations_;
   size_t num_given_inliers_ = 0;
+  // The map images (empty unless refine_points and map images):
+  // intrinsics, poses, per observation whether it was rejected.
+  std::vector<colmap::Camera> map_cameras_;
+  std::vector<PoseParams> map_cam_from_world_;
+  std::vector<std::vector<char>> map_rejected_;
+  size_t num_map_rejected_ = 0;
+  bool points_selected_ = false;
+  // cam_from_rig of a map image seen as a one-camera rig (the identity,
+  // constant), so that its residuals are RigReprojectionCosts too.
+  PoseParams identity_pose_ = {1, 0, 0, 0, 0, 0, 0};
   // By point3D_id: the map positions and the points being refined.
   std::unordered_map<int64_t, Eigen::Vector3d> map_points_;
   std::unordered_map<int64_t, Eigen::Vector3d> refined_points_;

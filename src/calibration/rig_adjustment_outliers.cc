@@ -10,61 +10,105 @@
 namespace rig_calibrator {
 
 size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
-  std::vector<ObservationError> errors(observations_.size());
+  if (options_.refine_points && !points_selected_) {
+    SelectRefinedPoints();
+  }
+  // (slot, error) of the rig observations, then of the map observations of
+  // the points being refined.
+  std::vector<std::pair<int, ObservationError>> errors;
+  errors.reserve(observations_.size());
   std::vector<double> depths;
   depths.reserve(observations_.size());
-  for (size_t k = 0; k < observations_.size(); ++k) {
-    errors[k] = Evaluate(observations_[k]);
-    if (errors[k].depth > 0) {
-      depths.push_back(errors[k].depth);
+  for (const Observation& observation : observations_) {
+    errors.emplace_back(CameraOf(observation), Evaluate(observation));
+    if (errors.back().second.depth > 0) {
+      depths.push_back(errors.back().second.depth);
     }
+  }
+  const std::vector<MapObservationRef> map_observations =
+      MapObservationsInProblem();
+  for (const MapObservationRef& observation : map_observations) {
+    errors.emplace_back(MapCameraSlot(observation), Evaluate(observation));
   }
   const double max_depth =
       depths.empty() ? 0 : options_.max_depth_factor * colmap::Median(depths);
-  std::vector<double> max_error_px(cameras_.size(),
+  std::vector<double> max_error_px(cameras_.size() + map_cameras_.size(),
                                    std::numeric_limits<double>::infinity());
   if (prune_residuals) {
-    max_error_px = MaxErrorPerCamera(errors);
+    max_error_px = MaxErrorPerSlot(errors);
   }
+  const auto fits = [&](const std::pair<int, ObservationError>& error) {
+    return error.second.depth > 0 &&
+           error.second.residual.norm() <= max_error_px[error.first];
+  };
+  const size_t num_rig = observations_.size();
   std::vector<Observation> kept;
-  kept.reserve(observations_.size());
-  for (size_t k = 0; k < observations_.size(); ++k) {
-    if (errors[k].depth > 0 && errors[k].depth <= max_depth &&
-        errors[k].residual.norm() <= max_error_px[CameraOf(observations_[k])]) {
+  kept.reserve(num_rig);
+  for (size_t k = 0; k < num_rig; ++k) {
+    if (fits(errors[k]) && errors[k].second.depth <= max_depth) {
       kept.push_back(observations_[k]);
     }
   }
-  const size_t num_removed = observations_.size() - kept.size();
+  size_t num_removed = num_rig - kept.size();
   observations_ = std::move(kept);
+  for (size_t k = 0; k < map_observations.size(); ++k) {
+    if (!fits(errors[num_rig + k])) {
+      map_rejected_[map_observations[k].image]
+                   [map_observations[k].observation] = 1;
+      ++num_map_rejected_;
+      ++num_removed;
+    }
+  }
   return num_removed;
 }
 
-// sigma = 1.4826 * MAD of the x and y residual components of the camera: the
-// robust standard deviation of one component (1.4826 = 1 / Phi^-1(3/4) makes
-// the MAD of a Gaussian its sigma).
-std::vector<double> RigAdjustment::MaxErrorPerCamera(
-    const std::vector<ObservationError>& errors) const {
-  std::vector<std::vector<double>> components(cameras_.size());
-  for (size_t k = 0; k < observations_.size(); ++k) {
-    if (errors[k].depth > 0) {
-      const int camera = CameraOf(observations_[k]);
-      components[camera].push_back(errors[k].residual.x());
-      components[camera].push_back(errors[k].residual.y());
+size_t RigAdjustment::RejectMapOutliers() {
+  const std::vector<MapObservationRef> map_observations =
+      MapObservationsOfRefinedPoints();
+  std::vector<std::pair<int, ObservationError>> errors;
+  errors.reserve(map_observations.size());
+  for (const MapObservationRef& observation : map_observations) {
+    errors.emplace_back(MapCameraSlot(observation), Evaluate(observation));
+  }
+  const std::vector<double> max_error_px = MaxErrorPerSlot(errors);
+  size_t num_rejected = 0;
+  for (size_t k = 0; k < map_observations.size(); ++k) {
+    if (!(errors[k].second.depth > 0 &&
+          errors[k].second.residual.norm() <= max_error_px[errors[k].first])) {
+      map_rejected_[map_observations[k].image]
+                   [map_observations[k].observation] = 1;
+      ++num_rejected;
     }
   }
-  std::vector<double> max_error_px(cameras_.size(),
-                                   options_.min_outlier_error_px);
-  for (size_t camera = 0; camera < cameras_.size(); ++camera) {
-    if (components[camera].empty()) {
+  num_map_rejected_ += num_rejected;
+  return num_rejected;
+}
+
+// sigma = 1.4826 * MAD of the x and y residual components of the slot: the
+// robust standard deviation of one component (1.4826 = 1 / Phi^-1(3/4) makes
+// the MAD of a Gaussian its sigma).
+std::vector<double> RigAdjustment::MaxErrorPerSlot(
+    const std::vector<std::pair<int, ObservationError>>& errors) const {
+  const size_t num_slots = cameras_.size() + map_cameras_.size();
+  std::vector<std::vector<double>> components(num_slots);
+  for (const auto& [slot, error] : errors) {
+    if (error.depth > 0) {
+      components[slot].push_back(error.residual.x());
+      components[slot].push_back(error.residual.y());
+    }
+  }
+  std::vector<double> max_error_px(num_slots, options_.min_outlier_error_px);
+  for (size_t slot = 0; slot < num_slots; ++slot) {
+    if (components[slot].empty()) {
       continue;
     }
-    const double median = colmap::Median(components[camera]);
-    for (double& component : components[camera]) {
+    const double median = colmap::Median(components[slot]);
+    for (double& component : components[slot]) {
       component = std::abs(component - median);
     }
-    const double sigma = 1.4826 * colmap::Median(components[camera]);
-    max_error_px[camera] = std::max(options_.min_outlier_error_px,
-                                    options_.outlier_sigma_factor * sigma);
+    const double sigma = 1.4826 * colmap::Median(components[slot]);
+    max_error_px[slot] = std::max(options_.min_outlier_error_px,
+                                  options_.outlier_sigma_factor * sigma);
   }
   return max_error_px;
 }

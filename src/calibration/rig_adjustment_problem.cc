@@ -1,6 +1,8 @@
 // The Ceres problem of the final bundle adjustment: one RigReprojectionCost
-// per observation, the blocks that are held constant or partly constant, and
-// the solver set-up (Schur elimination of the rig poses or map points).
+// per observation (a map image's: its cam_from_world as the "rig" pose, a
+// constant identity cam_from_rig), the blocks that are held constant or partly
+// constant, and the solver set-up (Schur elimination of the rig poses or map
+// points).
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -57,9 +59,39 @@ void RigAdjustment::AddResidualBlocks(ceres::Problem* problem) {
           loss_.get(), rig_from_world, cam_from_rig, camera.ParamsData());
     }
   }
+  for (const MapObservationRef& observation : MapObservationsInProblem()) {
+    const MapObservation& map_observation = MapObservationOf(observation);
+    colmap::Camera& camera =
+        map_cameras_[dataset_.map_images[observation.image].camera_index];
+    problem->AddResidualBlock(
+        CreateRigReprojectionCost(camera.ModelId(), map_observation.point2D,
+                                  nullptr),
+        loss_.get(), map_cam_from_world_[observation.image].data(),
+        identity_pose_.data(), camera.ParamsData(),
+        refined_points_.at(map_observation.point3D_id).data());
+    has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
+  }
 }
 
 void RigAdjustment::SetUpParameterBlocks(ceres::Problem* problem) {
+  if (problem->HasParameterBlock(identity_pose_.data())) {
+    problem->SetParameterBlockConstant(identity_pose_.data());
+  }
+  for (PoseParams& pose : map_cam_from_world_) {
+    if (problem->HasParameterBlock(pose.data())) {
+      if (options_.refine_map) {
+        problem->SetManifold(pose.data(), pose_manifold_.get());
+      } else {
+        problem->SetParameterBlockConstant(pose.data());
+      }
+    }
+  }
+  for (colmap::Camera& camera : map_cameras_) {
+    if (problem->HasParameterBlock(camera.ParamsData()) &&
+        !(options_.refine_map && options_.refine_map_intrinsics)) {
+      problem->SetParameterBlockConstant(camera.ParamsData());
+    }
+  }
   for (PoseParams& pose : rig_from_world_) {
     if (problem->HasParameterBlock(pose.data())) {
       if (options_.refine_rig_poses) {

@@ -7,6 +7,36 @@ bool IsFinite(const Rigid3d& pose) {
   return pose.rotation.coeffs().allFinite() && pose.translation.allFinite();
 }
 
+// The map part of ValidateCalibration.
+bool ValidateMapResults(const RigDataset& dataset,
+                        const RigCalibration& calibration, std::string* error) {
+  if (calibration.map_cameras.empty() &&
+      calibration.map_cam_from_world.empty() &&
+      calibration.map_observation_rejected.empty()) {
+    return true;
+  }
+  if (calibration.map_cameras.size() != dataset.map_cameras.size() ||
+      calibration.map_cam_from_world.size() != dataset.map_images.size() ||
+      calibration.map_observation_rejected.size() !=
+          dataset.map_images.size()) {
+    *error = "the calibration's map results do not match the dataset's " +
+             std::to_string(dataset.map_cameras.size()) + " map cameras and " +
+             std::to_string(dataset.map_images.size()) + " map images";
+    return false;
+  }
+  for (size_t i = 0; i < dataset.map_images.size(); ++i) {
+    const MapImage& image = dataset.map_images[i];
+    if (!IsFinite(calibration.map_cam_from_world[i]) ||
+        calibration.map_observation_rejected[i].size() !=
+            image.observations.size()) {
+      *error = "the map image " + image.name +
+               " has a non-finite pose or a wrong number of rejection flags";
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool ValidateDataset(const RigDataset& dataset, std::string* error) {
@@ -44,6 +74,35 @@ bool ValidateDataset(const RigDataset& dataset, std::string* error) {
         *error = "image " + image.name + " has a non-finite correspondence";
         return false;
       }
+    }
+  }
+  for (const colmap::Camera& camera : dataset.map_cameras) {
+    if (!camera.VerifyParams()) {
+      *error = "a map camera (id " + std::to_string(camera.CameraId()) +
+               ") has invalid parameters for model " + camera.ModelName();
+      return false;
+    }
+  }
+  for (const MapImage& image : dataset.map_images) {
+    if (image.camera_index < 0 ||
+        image.camera_index >= static_cast<int>(dataset.map_cameras.size()) ||
+        !IsFinite(image.cam_from_world)) {
+      *error = "map image " + image.name + " has no valid camera or pose";
+      return false;
+    }
+    for (const MapObservation& observation : image.observations) {
+      if (!observation.point2D.allFinite() ||
+          dataset.map_points3D.count(observation.point3D_id) == 0) {
+        *error = "map image " + image.name +
+                 " has a non-finite observation or one of an unknown point";
+        return false;
+      }
+    }
+  }
+  for (const auto& [point3D_id, point] : dataset.map_points3D) {
+    if (!point.allFinite()) {
+      *error = "map point " + std::to_string(point3D_id) + " is not finite";
+      return false;
     }
   }
   return true;
@@ -95,7 +154,7 @@ bool ValidateCalibration(const RigDataset& dataset,
       return false;
     }
   }
-  return true;
+  return ValidateMapResults(dataset, calibration, error);
 }
 
 }  // namespace rig_calibrator

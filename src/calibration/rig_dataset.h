@@ -40,11 +40,37 @@ struct RigCamera {
   bool intrinsics_known = false;
 };
 
+// One observation of a map point by a map image: the keypoint and its index
+// among the image's points2D (in the map model and its database).
+struct MapObservation {
+  Eigen::Vector2d point2D = Eigen::Vector2d::Zero();  // pixels
+  int64_t point3D_id = -1;
+  uint32_t point2D_idx = 0;
+};
+
+// One registered image of the map that the rig is calibrated against, with
+// its observations of map points: the map's own evidence of where its points
+// are, used when the final bundle adjustment refines them.
+struct MapImage {
+  std::string name;
+  int64_t image_id = -1;  // in the map model
+  int camera_index = -1;  // into RigDataset::map_cameras
+  Rigid3d cam_from_world;
+  std::vector<MapObservation> observations;
+};
+
 struct RigDataset {
   std::vector<RigCamera> cameras;
   std::vector<std::string> frameset_names;  // one per frameset
   std::vector<RigImage> images;
   int reference_camera = 0;  // its cam_from_rig is the identity
+  // The map's cameras and images (empty when there is no map, e.g. a run
+  // from a correspondence file alone). The map point positions are those of
+  // the correspondences and `map_points3D`.
+  std::vector<colmap::Camera> map_cameras;
+  std::vector<MapImage> map_images;
+  // Every map point observed by a map image, by point3D_id.
+  std::unordered_map<int64_t, Eigen::Vector3d> map_points3D;
 };
 
 // What became of one image.
@@ -67,6 +93,14 @@ struct RigCalibration {
   // Map points moved by a final bundle adjustment that refines points, by
   // point3D_id; empty when the map is held fixed (the default).
   std::unordered_map<int64_t, Eigen::Vector3d> refined_points3D;
+  // After a final bundle adjustment with map images (else empty): per map
+  // camera its intrinsics, per map image its cam_from_world (the map's
+  // unless the map was refined) and per observation whether it was rejected
+  // (its point refined, the observation no longer fitting: the output model
+  // drops it from the point's track).
+  std::vector<colmap::Camera> map_cameras;
+  std::vector<Rigid3d> map_cam_from_world;
+  std::vector<std::vector<char>> map_observation_rejected;
 
   Rigid3d CamFromWorld(int camera_index, int frameset_index) const {
     return cam_from_rig[camera_index] * *rig_from_world[frameset_index];
@@ -76,14 +110,17 @@ struct RigCalibration {
 // The one check of a calibration problem, whatever its source: at least two
 // cameras, a valid reference camera, every camera with an image size and
 // parameters valid for its model, every image with a valid camera and
-// frameset, and finite correspondences. Returns false with `error` naming the
-// camera or image and what is wrong.
+// frameset, and finite correspondences; every map image with a valid map
+// camera, a finite pose and finite observations of points in map_points3D.
+// Returns false with `error` naming the camera or image and what is wrong.
 bool ValidateDataset(const RigDataset& dataset, std::string* error);
 
 // ValidateDataset, and a calibration shaped like the dataset: one entry per
 // camera (intrinsics, cam_from_rig, calibrated flag), per frameset
 // (rig_from_world) and per image (result); finite cam_from_rig and
-// rig_from_world; every non-empty inlier mask one flag per correspondence.
+// rig_from_world; every non-empty inlier mask one flag per correspondence;
+// the map results empty or one entry per map camera, map image and
+// observation.
 // Returns false with `error` naming the camera, frameset or image.
 bool ValidateCalibration(const RigDataset& dataset,
                          const RigCalibration& calibration, std::string* error);

@@ -61,6 +61,7 @@ class PointGenerator {
                   int64_t* point3D_id);
 
   const Eigen::Vector3d& Point(int64_t id) const { return points_[id]; }
+  const std::vector<Eigen::Vector3d>& Points() const { return points_; }
 
  private:
   int64_t AddPoint(const Eigen::Vector3d& point, int frameset);

@@ -14,6 +14,7 @@
 #include "src/synthetic/correspondence_generator.h"
 #include "src/synthetic/rig_motion.h"
 #include "src/synthetic/rig_presets.h"
+#include "src/synthetic/synthetic_map.h"
 
 namespace rig_calibrator {
 namespace {
@@ -191,6 +192,12 @@ bool SyntheticRigOptions::Check(std::string* error) const {
             << RigPresetName(preset);
   } else if (!(feature_window > 0 && feature_window <= 1)) {
     message << "feature_window must be in (0, 1], got " << feature_window;
+  } else if (num_map_images < 0 || !(map_noise_px >= 0) ||
+             !(map_point_noise >= 0)) {
+    message << "num_map_images, map_noise_px and map_point_noise must be "
+               ">= 0, got "
+            << num_map_images << ", " << map_noise_px << ", "
+            << map_point_noise;
   } else {
     return true;
   }
@@ -247,6 +254,10 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
                     &generator, &rng, &rig);
     }
   }
+  rig.true_points3D = generator.Points();
+  // A separate random stream, so that the rig images stay those of earlier
+  // versions for the same seed.
+  AddSyntheticMap(options, &rig);
   return rig;
 }
 
@@ -254,6 +265,11 @@ SyntheticRig SelectFramesets(const SyntheticRig& rig,
                              const std::vector<int>& framesets) {
   SyntheticRig selected;
   selected.dataset.cameras = rig.dataset.cameras;
+  selected.dataset.map_cameras = rig.dataset.map_cameras;
+  selected.dataset.map_images = rig.dataset.map_images;
+  selected.dataset.map_points3D = rig.dataset.map_points3D;
+  selected.true_points3D = rig.true_points3D;
+  selected.true_map_cam_from_world = rig.true_map_cam_from_world;
   selected.dataset.reference_camera = rig.dataset.reference_camera;
   selected.truth = rig.truth;
   selected.truth.rig_from_world.clear();

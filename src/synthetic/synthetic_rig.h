@@ -82,6 +82,14 @@ struct SyntheticRigOptions {
   // i mod 5 and its focal lengths scaled by 1 + 0.03 * floor(i / 5). E.g. 10
   // for a 10-camera rig (runtime benchmark).
   int ring_num_cameras = 0;
+  // Map images (synthetic_map.h): how many, the Gaussian noise on their
+  // observations (pixels per coordinate), and the error of the map points
+  // given to the calibration (map units per coordinate, Gaussian): a map's
+  // points are only as good as its triangulation. 0 map images: none (the
+  // default; the map points are then exact unless map_point_noise > 0).
+  int num_map_images = 0;
+  double map_noise_px = 0.5;
+  double map_point_noise = 0.0;
   unsigned int seed = 0;
 
   // False (with a message) for values outside their ranges.
@@ -97,6 +105,11 @@ struct SyntheticRig {
   RigGroundTruth truth;
   // Per dataset image, per correspondence: 1 for a wrong match.
   std::vector<std::vector<char>> is_outlier;
+  // The true map points, by point3D_id (the dataset's are these plus
+  // map_point_noise).
+  std::vector<Eigen::Vector3d> true_points3D;
+  // The true pose of every dataset map image.
+  std::vector<Rigid3d> true_map_cam_from_world;
 };
 
 // Deterministic for a seed. With invalid options, logs the error and returns a

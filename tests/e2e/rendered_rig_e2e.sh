@@ -87,6 +87,7 @@ echo "[e2e] colmap model_analyzer: ${registered:-?} registered images (map: ${ma
 [[ -n "$registered" && -n "$map_registered" && "$registered" -gt "$map_registered" ]] ||
   fail "colmap model_analyzer finds no rig image in the calibrated model"
 "$checker" "$calibration" || fail "the outputs of $calibration disagree"
+"$build/tests/check_output_model" "$calibration" "$work/demo/map/sparse/0" || fail "the output model's errors are not its own"
 # The checker itself must see a wrong file: the true rig's rig_config.json in
 # place of the calibrated one (they differ by the calibration error).
 tampered="$work/tampered"

@@ -220,6 +220,19 @@ TEST_F(CalibrateCommandBadInput, MissingOptionsAndPaths) {
               {missing});
 }
 
+TEST_F(CalibrateCommandBadInput, MapOptionsAndExportDatabase) {
+  // The export never overwrites: neither the input database nor another file.
+  ExpectFails(With(Arguments(), "--RigCalibrator.export_database", database_),
+              {"--RigCalibrator.export_database " + database_ + " exists"});
+  ExpectFails({"--correspondences_path", database_, "--output_path", output_,
+               "--RigCalibrator.export_database", inputs_ + "/new.db"},
+              {"--RigCalibrator.export_database needs the map's database"});
+  ExpectFails(With(With(Arguments(), "--RigCalibrator.refine_map", "0"),
+                   "--RigCalibrator.refine_map_intrinsics", "1"),
+              {"--RigCalibrator.refine_map_intrinsics 1 needs "
+               "--RigCalibrator.refine_map 1"});
+}
+
 TEST_F(CalibrateCommandBadInput, PathsOfTheWrongKind) {
   // A folder as the database, a file as the image folder, a file as the map.
   ExpectFails(With(Arguments(), "--database_path", rig_images_),

@@ -1,0 +1,58 @@
+#include "colmap_ext/io/model_errors.h"
+
+#include <colmap/base/projection.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rig_calibrator {
+
+double ObservationError(const colmap::Reconstruction& model,
+                        colmap::image_t image_id,
+                        colmap::point2D_t point2D_idx) {
+  const colmap::Image& image = model.Image(image_id);
+  const colmap::Point2D& point2D = image.Point2D(point2D_idx);
+  const double squared_error = colmap::CalculateSquaredReprojectionError(
+      point2D.XY(), model.Point3D(point2D.Point3DId()).XYZ(), image.Qvec(),
+      image.Tvec(), model.Camera(image.CameraId()));
+  return squared_error == std::numeric_limits<double>::max()
+             ? std::numeric_limits<double>::infinity()
+             : std::sqrt(squared_error);
+}
+
+ReprojectionStats ComputeReprojectionStats(
+    const colmap::Reconstruction& model,
+    const std::unordered_set<colmap::image_t>& image_ids) {
+  ReprojectionStats stats;
+  double sum = 0;
+  for (const auto& [point3D_id, point3D] : model.Points3D()) {
+    for (const colmap::TrackElement& element : point3D.Track().Elements()) {
+      if (!image_ids.empty() && image_ids.count(element.image_id) == 0) {
+        continue;
+      }
+      const double error =
+          ObservationError(model, element.image_id, element.point2D_idx);
+      ++stats.num_observations;
+      sum += error;
+      stats.max_px = std::max(stats.max_px, error);
+      stats.num_above_4px += error > 4 ? 1 : 0;
+    }
+  }
+  stats.mean_px = stats.num_observations > 0 ? sum / stats.num_observations : 0;
+  return stats;
+}
+
+void RecomputePointErrors(colmap::Reconstruction* model) {
+  for (const colmap::point3D_t point3D_id : model->Point3DIds()) {
+    colmap::Point3D& point3D = model->Point3D(point3D_id);
+    double sum = 0;
+    for (const colmap::TrackElement& element : point3D.Track().Elements()) {
+      sum += ObservationError(*model, element.image_id, element.point2D_idx);
+    }
+    point3D.SetError(
+        point3D.Track().Length() > 0 ? sum / point3D.Track().Length() : 0);
+  }
+}
+
+}  // namespace rig_calibrator

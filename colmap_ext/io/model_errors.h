@@ -1,0 +1,39 @@
+// Reprojection errors of a COLMAP model recomputed from its own cameras,
+// poses and points (the errors COLMAP stores per point are whatever the
+// model's writer last set; these are what COLMAP's bundle_adjuster would
+// compute).
+#pragma once
+
+#include <colmap/base/reconstruction.h>
+
+#include <cstdint>
+#include <unordered_set>
+
+namespace rig_calibrator {
+
+// Statistics of |pi(P X) - x| (pixels) over a set of observations.
+struct ReprojectionStats {
+  int64_t num_observations = 0;
+  double mean_px = 0;
+  double max_px = 0;
+  int64_t num_above_4px = 0;
+};
+
+// The reprojection error of observation (image_id, point2D_idx) of a point
+// of `model` (infinite behind the camera).
+double ObservationError(const colmap::Reconstruction& model,
+                        colmap::image_t image_id,
+                        colmap::point2D_t point2D_idx);
+
+// Over every observation of a point by the images in `image_ids` (all
+// registered images if empty).
+ReprojectionStats ComputeReprojectionStats(
+    const colmap::Reconstruction& model,
+    const std::unordered_set<colmap::image_t>& image_ids = {});
+
+// Sets every point's error to the mean of its observations' reprojection
+// errors, COLMAP's definition (Point3D::Error; model_analyzer's mean
+// reprojection error is the mean of these over the points).
+void RecomputePointErrors(colmap::Reconstruction* model);
+
+}  // namespace rig_calibrator
