@@ -3,6 +3,7 @@
 // The options are in calibrate_options.h, the assembly of the calibration
 // problem in calibration_input.h, what is reported in calibration_report.h.
 #include <iostream>
+#include <unordered_set>
 
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/commands/calibration_input.h"
@@ -71,7 +72,17 @@ int RunCalibrate(int argc, char** argv) {
           : LoadFromDatabase(options, map, &dataset, &layout, &error,
                              &known_rig);
   if (!loaded) return PrintError(error);
-  AddMapImages(map, &dataset);
+  std::unordered_set<colmap::camera_t> placeholder_cameras;
+  for (const CameraRecord& camera : map_info.newer_model_cameras) {
+    placeholder_cameras.insert(camera.camera_id);
+  }
+  if (const int num_left_out =
+          AddMapImages(map, placeholder_cameras, &dataset)) {
+    std::cout << "  " << num_left_out
+              << " map image(s) of camera models newer than COLMAP 3.8 take "
+                 "no part in the final adjustment and keep their input poses"
+              << std::endl;
+  }
 
   RigCalibration calibration;
   PipelineReport report;
@@ -79,9 +90,9 @@ int RunCalibrate(int argc, char** argv) {
     PrintDiagnostics(report);
     return PrintError("calibration failed: " + report.error);
   }
-  const CalibrationSummary summary = MakeCalibrationSummary(
-      dataset, calibration, layout.camera_prefixes, report, pipeline.seed,
-      known_rig);
+  const CalibrationSummary summary =
+      MakeCalibrationSummary(dataset, calibration, layout.camera_prefixes,
+                             report, pipeline.seed, known_rig);
   std::vector<std::string> notes;
   if (!WriteRigOutput(options.output_path, map, dataset, calibration,
                       layout.camera_prefixes, summary,

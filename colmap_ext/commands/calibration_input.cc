@@ -488,10 +488,18 @@ bool LoadFromCorrespondences(const CalibrateOptions& options,
   return true;
 }
 
-void AddMapImages(const colmap::Reconstruction& map, RigDataset* dataset) {
+int AddMapImages(
+    const colmap::Reconstruction& map,
+    const std::unordered_set<colmap::camera_t>& placeholder_cameras,
+    RigDataset* dataset) {
   std::map<colmap::camera_t, int> camera_index;
+  int num_left_out = 0;
   for (const colmap::image_t image_id : map.RegImageIds()) {
     const colmap::Image& image = map.Image(image_id);
+    if (placeholder_cameras.count(image.CameraId()) > 0) {
+      ++num_left_out;
+      continue;
+    }
     const auto [it, inserted] = camera_index.emplace(
         image.CameraId(), static_cast<int>(dataset->map_cameras.size()));
     if (inserted) {
@@ -518,6 +526,7 @@ void AddMapImages(const colmap::Reconstruction& map, RigDataset* dataset) {
   for (const auto& [point3D_id, point3D] : map.Points3D()) {
     dataset->map_points3D[static_cast<int64_t>(point3D_id)] = point3D.XYZ();
   }
+  return num_left_out;
 }
 
 }  // namespace rig_calibrator

@@ -7,6 +7,7 @@
 #include <colmap/base/reconstruction.h>
 
 #include <string>
+#include <unordered_set>
 
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/io/calibration_summary.h"
@@ -36,6 +37,12 @@ bool LoadFromCorrespondences(const CalibrateOptions& options,
 // Adds the registered images of `map` with their cameras, poses and
 // observations of map points, and every map point, to the dataset (for the
 // final bundle adjustment's map observations).
-void AddMapImages(const colmap::Reconstruction& map, RigDataset* dataset);
+// Returns the number of map images left out because their camera is a
+// placeholder for a model newer than COLMAP 3.8 (`placeholder_cameras`), which
+// this build cannot project.
+int AddMapImages(
+    const colmap::Reconstruction& map,
+    const std::unordered_set<colmap::camera_t>& placeholder_cameras,
+    RigDataset* dataset);
 
 }  // namespace rig_calibrator

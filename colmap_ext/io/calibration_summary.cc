@@ -74,7 +74,6 @@ bool WriteJson(const std::string& path, const Json& root, std::string* error) {
 
 }  // namespace
 
-
 void CompareWithKnownRig(const KnownRigPrior& prior,
                          CalibrationSummary* summary) {
   const int ref = prior.reference_camera;

@@ -43,15 +43,23 @@ ReprojectionStats ComputeReprojectionStats(
   return stats;
 }
 
-void RecomputePointErrors(colmap::Reconstruction* model) {
+void RecomputePointErrors(
+    colmap::Reconstruction* model,
+    const std::unordered_set<colmap::image_t>& excluded_image_ids) {
   for (const colmap::point3D_t point3D_id : model->Point3DIds()) {
     colmap::Point3D& point3D = model->Point3D(point3D_id);
     double sum = 0;
+    int num_observations = 0;
     for (const colmap::TrackElement& element : point3D.Track().Elements()) {
+      if (excluded_image_ids.count(element.image_id) > 0) continue;
       sum += ObservationError(*model, element.image_id, element.point2D_idx);
+      ++num_observations;
     }
-    point3D.SetError(
-        point3D.Track().Length() > 0 ? sum / point3D.Track().Length() : 0);
+    if (num_observations > 0) {
+      point3D.SetError(sum / num_observations);
+    } else if (excluded_image_ids.empty()) {
+      point3D.SetError(0);
+    }
   }
 }
 

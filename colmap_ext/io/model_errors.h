@@ -33,7 +33,11 @@ ReprojectionStats ComputeReprojectionStats(
 
 // Sets every point's error to the mean of its observations' reprojection
 // errors, COLMAP's definition (Point3D::Error; model_analyzer's mean
-// reprojection error is the mean of these over the points).
-void RecomputePointErrors(colmap::Reconstruction* model);
+// reprojection error is the mean of these over the points). Observations by
+// `excluded_image_ids` (images whose camera this build cannot project) are
+// left out; a point seen only by them keeps its error.
+void RecomputePointErrors(
+    colmap::Reconstruction* model,
+    const std::unordered_set<colmap::image_t>& excluded_image_ids = {});
 
 }  // namespace rig_calibrator

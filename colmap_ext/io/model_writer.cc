@@ -232,10 +232,10 @@ bool AddRigFrames(const colmap::Reconstruction& map, const RigDataset& dataset,
 // rejected map observations), then every point's error recomputed, so that
 // the model's stored errors are its own (model_errors.h). Observations behind
 // their camera are dropped (COLMAP would count them as infinite).
-void ApplyMapResults(const RigDataset& dataset,
-                     const RigCalibration& calibration,
-                     colmap::Reconstruction* model,
-                     int64_t* num_dropped_map_observations) {
+void ApplyMapResults(
+    const RigDataset& dataset, const RigCalibration& calibration,
+    const std::unordered_set<colmap::image_t>& placeholder_images,
+    colmap::Reconstruction* model, int64_t* num_dropped_map_observations) {
   *num_dropped_map_observations = 0;
   if (!calibration.map_cam_from_world.empty()) {
     for (const colmap::Camera& camera : calibration.map_cameras) {
@@ -264,14 +264,15 @@ void ApplyMapResults(const RigDataset& dataset,
     }
   }
   model->FilterObservationsWithNegativeDepth();
-  RecomputePointErrors(model);
+  RecomputePointErrors(model, placeholder_images);
 }
 
 }  // namespace
 
-bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
-                   const RigCalibration& calibration, RigModel* rig_model,
-                   std::string* error) {
+bool BuildRigModel(
+    const colmap::Reconstruction& map, const RigDataset& dataset,
+    const RigCalibration& calibration, RigModel* rig_model, std::string* error,
+    const std::unordered_set<colmap::camera_t>& placeholder_map_cameras) {
   if (!ValidateCalibration(dataset, calibration, error)) {
     return false;
   }
@@ -292,12 +293,16 @@ bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
                     error)) {
     return false;
   }
-  ApplyMapResults(dataset, calibration, &rig_model->model,
-                  &rig_model->num_dropped_map_observations);
-  std::unordered_set<colmap::image_t> map_image_ids;
+  std::unordered_set<colmap::image_t> map_image_ids, placeholder_images;
   for (const colmap::image_t image_id : map.RegImageIds()) {
-    map_image_ids.insert(image_id);
+    if (placeholder_map_cameras.count(map.Image(image_id).CameraId()) > 0) {
+      placeholder_images.insert(image_id);
+    } else {
+      map_image_ids.insert(image_id);
+    }
   }
+  ApplyMapResults(dataset, calibration, placeholder_images, &rig_model->model,
+                  &rig_model->num_dropped_map_observations);
   if (!map_image_ids.empty()) {
     rig_model->map_input_errors = ComputeReprojectionStats(map, map_image_ids);
     rig_model->map_output_errors =
@@ -392,7 +397,12 @@ bool BuildRigOutputContents(const colmap::Reconstruction& map,
     *error = "one camera prefix per camera is needed";
     return false;
   }
-  if (!BuildRigModel(map, dataset, calibration, &contents->rig_model, error) ||
+  std::unordered_set<colmap::camera_t> placeholder_map_cameras;
+  for (const CameraRecord& camera : options.newer_model_map_cameras) {
+    placeholder_map_cameras.insert(camera.camera_id);
+  }
+  if (!BuildRigModel(map, dataset, calibration, &contents->rig_model, error,
+                     placeholder_map_cameras) ||
       !BuildRigsAndFrames(contents->rig_model.model, contents->rig_model.rig,
                           &contents->rigs_frames, error)) {
     return false;

@@ -18,6 +18,7 @@
 #include <colmap/base/reconstruction.h>
 
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "colmap_ext/io/calibration_summary.h"
@@ -65,9 +66,12 @@ struct RigModel {
 // Fails, leaving `rig_model` unspecified, if the calibration does not match
 // the dataset, intrinsics are invalid, a refined point or a rig image name is
 // already in the map, or the ids overflow.
-bool BuildRigModel(const colmap::Reconstruction& map, const RigDataset& dataset,
-                   const RigCalibration& calibration, RigModel* rig_model,
-                   std::string* error);
+// Map images of `placeholder_map_cameras` (models newer than COLMAP 3.8, held
+// as placeholders by ReadMap) are left out of the recomputed errors.
+bool BuildRigModel(
+    const colmap::Reconstruction& map, const RigDataset& dataset,
+    const RigCalibration& calibration, RigModel* rig_model, std::string* error,
+    const std::unordered_set<colmap::camera_t>& placeholder_map_cameras = {});
 
 struct RigOutputOptions {
   std::string output_type = "BIN";  // "BIN" or "TXT", as COLMAP's
