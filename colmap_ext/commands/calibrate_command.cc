@@ -9,6 +9,7 @@
 #include "colmap_ext/commands/calibration_report.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/model_writer.h"
 
@@ -51,7 +52,11 @@ int RunCalibrate(int argc, char** argv) {
   std::string error;
   PipelineOptions pipeline;
   colmap::Reconstruction map;
+  OutputFolderOptions output_folder;
+  output_folder.overwrite = options.overwrite;
+  output_folder.input_paths = MakeOutputOptions(options).input_paths;
   if (!MakePipelineOptions(&options, &pipeline, &error) ||
+      !CheckOutputFolderUsable(options.output_path, output_folder, &error) ||
       !ReadInputMap(options, &map, &error)) {
     return PrintError(error);
   }

@@ -22,10 +22,23 @@ struct OutputFolderOptions {
   std::vector<std::string> input_paths;
 };
 
+// The checks WriteFolderAtomically makes before writing (the output overlaps
+// no input, is an empty folder or absent, or overwrite is set), and that the
+// folder holding it is writable, with the message it would give: to fail
+// before a long computation rather than after it.
+bool CheckOutputFolderUsable(const std::string& output_path,
+                             const OutputFolderOptions& options,
+                             std::string* error);
+
 // Fills the folder `output_path` through `write_contents`, which gets a fresh
 // temporary sibling folder to write into. Only if it returns true is the
 // temporary folder renamed to `output_path`; otherwise (or on any file system
 // error) the temporary folder is removed and `output_path` is left as it was.
+// The rename fails (and nothing is replaced) if another process created or
+// filled `output_path` meanwhile, so of two runs into one output one wins;
+// with overwrite the old and new folders are swapped in one step
+// (RENAME_EXCHANGE). Temporary siblings left by killed runs (whose process
+// no longer exists) are removed first, with a line on stdout.
 bool WriteFolderAtomically(
     const std::string& output_path, const OutputFolderOptions& options,
     const std::function<bool(const std::string& folder, std::string* error)>&
