@@ -131,7 +131,13 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents,
     file.close();
     if (!file) {
       // errno of the failed write or close, e.g. ENOSPC on a full disk.
-      const std::string reason = std::strerror(errno);
+      const int write_errno = errno;
+      const std::string reason =
+          std::strerror(write_errno) +
+          std::string(write_errno == ENOSPC
+                          ? " (free space there or choose another output "
+                            "folder)"
+                          : "");
       std::error_code ignored;
       fs::remove(temporary, ignored);
       *error = "cannot write " + temporary.string() + " (for " + path +

@@ -118,10 +118,13 @@ TEST(DegenerateRig, RotationOnlyRigIsCalibrated) {
   SyntheticRigOptions options = HardScenario(RigPreset::kRing5);
   options.rotation_only = true;
   const SyntheticRig rig = GenerateSyntheticRig(options);
+  // The body origin stays put; the rig origin (camera 0, 0.15 m off the
+  // ring's center) moves on a sphere about it (a normal walk moves 0.4 m
+  // per frameset).
   const Eigen::Vector3d center0 =
       rig.truth.rig_from_world.front().Inverse().translation;
   for (const Rigid3d& rig_from_world : rig.truth.rig_from_world) {
-    EXPECT_LT((rig_from_world.Inverse().translation - center0).norm(), 1e-12);
+    EXPECT_LT((rig_from_world.Inverse().translation - center0).norm(), 0.3);
   }
   const Result result = Calibrate(rig);
   EXPECT_EQ(result.report.used_method, CalibrationMethod::kRadial1D);
@@ -158,6 +161,7 @@ TEST(DegenerateRig, MapUnitsChangeOnlyTheScale) {
     EXPECT_EQ(scaled.report.used_method, metric.report.used_method);
     EXPECT_EQ(scaled.report.num_used, metric.report.num_used) << scale;
     double max_param = 0, max_rotation_deg = 0, max_translation = 0;
+    double max_initial_rotation_deg = 0;
     for (size_t c = 0; c < metric.calibration.cameras.size(); ++c) {
       const std::vector<double>& a = metric.calibration.cameras[c].Params();
       const std::vector<double>& b = scaled.calibration.cameras[c].Params();
@@ -171,12 +175,25 @@ TEST(DegenerateRig, MapUnitsChangeOnlyTheScale) {
           max_rotation_deg, RotationDifferenceDeg(p.rotation, q.rotation));
       max_translation = std::max(
           max_translation, (p.translation - q.translation / scale).norm());
+      max_initial_rotation_deg =
+          std::max(max_initial_rotation_deg,
+                   RotationDifferenceDeg(
+                       metric.report.initial_cam_from_rig[c].rotation,
+                       scaled.report.initial_cam_from_rig[c].rotation));
     }
     std::cout << "map scale " << scale << " vs metres: intrinsics (relative) "
               << max_param << ", cam_from_rig rotation " << max_rotation_deg
-              << " deg, translation " << max_translation << " m" << std::endl;
+              << " deg, translation " << max_translation
+              << " m; initial rig rotation " << max_initial_rotation_deg
+              << " deg" << std::endl;
+    // Not bit-identical: the solvers stop at relative tolerances (Ceres'
+    // function_tolerance 1e-5, rig_adjustment_problem.cc) and the rig
+    // initializer weighs translation in
+    // radians per map unit (RigInitializerOptions::translation_weight), so
+    // the iterations differ; the differences are four orders below the
+    // calibration's own error (0.02 deg, 1 mm).
     EXPECT_LT(max_param, 1e-6) << scale;
-    EXPECT_LT(max_rotation_deg, 1e-6) << scale;
+    EXPECT_LT(max_rotation_deg, 1e-4) << scale;
     EXPECT_LT(max_translation, 1e-6) << scale;
     ExpectAccurate(
         [&] {
