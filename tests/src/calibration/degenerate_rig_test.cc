@@ -137,6 +137,21 @@ TEST(DegenerateRig, NearlyPlanarSceneIsCalibrated) {
   SyntheticRigOptions options = HardScenario(RigPreset::kRing5);
   options.near_planar_ratio = 1.0;
   const SyntheticRig rig = GenerateSyntheticRig(options);
+  int num_correct = 0, num_on_ground = 0;
+  for (size_t i = 0; i < rig.dataset.images.size(); ++i) {
+    const std::vector<Correspondence>& correspondences =
+        rig.dataset.images[i].correspondences;
+    for (size_t k = 0; k < correspondences.size(); ++k) {
+      if (rig.is_outlier[i][k]) continue;
+      ++num_correct;
+      if (std::abs(correspondences[k].point3D.z()) < 1e-9) ++num_on_ground;
+    }
+  }
+  const double planar_share = static_cast<double>(num_on_ground) / num_correct;
+  std::cout << "planar scene: " << 100 * planar_share
+            << " % of the correct correspondences on the ground plane"
+            << std::endl;
+  EXPECT_GT(planar_share, 0.5);
   const Result result = Calibrate(rig);
   for (const Diagnostic& diagnostic : result.report.diagnostics) {
     std::cout << "planar scene: " << diagnostic.code << ": "
