@@ -81,8 +81,9 @@ pid_t TemporarySiblingOwner(const fs::path& path, const std::string& name,
   return 0;
 }
 
-// Removes the temporary siblings of `path` that a killed run left behind
-// (kill -9, power loss): those whose process no longer exists. Running
+// Removes the temporary siblings (files or folders) of `path` that a killed
+// run left behind (kill -9, power loss): those whose process no longer
+// exists. Running
 // processes' folders (e.g. a run into the same output right now) are kept.
 void RemoveStaleSiblings(const fs::path& path) {
   const fs::path parent =
@@ -120,6 +121,7 @@ int RenameWithFlags(const fs::path& from, const fs::path& to,
 
 bool WriteFileAtomically(const std::string& path, const std::string& contents,
                          std::string* error) {
+  RemoveStaleSiblings(path);
   const fs::path temporary = TemporarySibling(path, "tmp");
   {
     std::ofstream file(temporary, std::ios::binary | std::ios::trunc);

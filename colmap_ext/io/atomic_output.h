@@ -10,7 +10,8 @@
 namespace rig_calibrator {
 
 // Writes `contents` to `path` through a temporary file in the same folder
-// and a rename (atomic on POSIX file systems).
+// and a rename (atomic on POSIX file systems). Temporary files of `path`
+// left by killed runs are removed first (as for folders, below).
 bool WriteFileAtomically(const std::string& path, const std::string& contents,
                          std::string* error);
 

@@ -191,6 +191,12 @@ TEST(AtomicOutput, StaleTemporaryFoldersOfDeadRunsAreRemoved) {
   EXPECT_TRUE(fs::exists(dir.File(".other.tmp-" + dead + "-1")));
   EXPECT_TRUE(fs::exists(dir.File(".out.tmp-x" + dead + "-1")));
   EXPECT_EQ(NumEntries(dir.path()), 4u);
+
+  // The same for the temporary file of a single file.
+  std::ofstream(dir.File(".f.txt.tmp-" + dead + "-3")) << "partial";
+  ASSERT_TRUE(WriteFileAtomically(dir.File("f.txt"), "f", &error)) << error;
+  EXPECT_FALSE(fs::exists(dir.File(".f.txt.tmp-" + dead + "-3")));
+  EXPECT_EQ(NumEntries(dir.path()), 5u);
 }
 
 // The early check of the command: a read-only file system is reported
