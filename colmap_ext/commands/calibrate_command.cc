@@ -10,6 +10,7 @@
 #include "colmap_ext/commands/calibration_report.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/database_export.h"
 #include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/model_writer.h"
@@ -59,7 +60,11 @@ int RunCalibrate(int argc, char** argv) {
   PipelineOptions pipeline;
   colmap::Reconstruction map;
   MapReadInfo map_info;
+  OutputFolderOptions output_folder;
+  output_folder.overwrite = options.overwrite;
+  output_folder.input_paths = MakeOutputOptions(options, map_info).input_paths;
   if (!MakePipelineOptions(&options, &pipeline, &error) ||
+      !CheckOutputFolderUsable(options.output_path, output_folder, &error) ||
       !ReadInputMap(options, &map, &map_info, &error)) {
     return PrintError(error);
   }

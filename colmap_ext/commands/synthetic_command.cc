@@ -49,6 +49,17 @@ int RunSynthetic(int argc, char** argv) {
             "nearest map points (map units)");
   AddOption(&description, "max_depth", &options.max_depth,
             "farthest map points (map units)");
+  AddOption(&description, "near_planar_ratio", &options.near_planar_ratio,
+            "share of the correct correspondences on the ground plane");
+  AddOption(&description, "stereo_num_pairs", &options.stereo_num_pairs,
+            "stereo_pair: number of pairs, 0.25 m above each other");
+  AddOption(&description, "stereo_alternate_facing",
+            &options.stereo_alternate_facing,
+            "stereo_pair: every second pair faces backward");
+  AddOption(&description, "rotation_only", &options.rotation_only,
+            "the rig only rotates about a fixed point");
+  AddOption(&description, "map_scale", &options.map_scale,
+            "map units per metre (1000: a map in millimetres)");
   AddOption(&description, "seed", &seed, "random seed");
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(

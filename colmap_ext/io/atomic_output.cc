@@ -1,9 +1,15 @@
 #include "colmap_ext/io/atomic_output.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <random>
 #include <system_error>
 
@@ -56,10 +62,66 @@ bool IsWithin(const fs::path& inner, const fs::path& outer) {
   return true;
 }
 
+// The process id in the name of a temporary sibling of `path` with one of
+// `tags` (".NAME.TAG-PID-RANDOM", TemporarySibling), or 0 for other names.
+pid_t TemporarySiblingOwner(const fs::path& path, const std::string& name,
+                            const std::vector<std::string>& tags) {
+  for (const std::string& tag : tags) {
+    const std::string prefix = "." + path.filename().string() + "." + tag + "-";
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos ||
+        rest.find_first_not_of("0123456789") != dash ||
+        rest.find_first_not_of("0123456789", dash + 1) != std::string::npos) {
+      return 0;
+    }
+    return static_cast<pid_t>(std::stoll(rest.substr(0, dash)));
+  }
+  return 0;
+}
+
+// Removes the temporary siblings (files or folders) of `path` that a killed
+// run left behind (kill -9, power loss): those whose process no longer
+// exists. Running
+// processes' folders (e.g. a run into the same output right now) are kept.
+void RemoveStaleSiblings(const fs::path& path) {
+  const fs::path parent =
+      path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::error_code code;
+  std::vector<fs::path> stale;
+  for (fs::directory_iterator it(parent, code), end; !code && it != end;
+       it.increment(code)) {
+    const pid_t owner = TemporarySiblingOwner(
+        path, it->path().filename().string(), {"tmp", "old"});
+    if (owner > 0 && owner != getpid() && kill(owner, 0) != 0 &&
+        errno == ESRCH) {
+      stale.push_back(it->path());
+    }
+  }
+  for (const fs::path& folder : stale) {
+    std::error_code ignored;
+    fs::remove_all(folder, ignored);
+    std::cout << "Removed " << folder.string()
+              << ", left by an interrupted run (its process no longer exists)"
+              << std::endl;
+  }
+}
+
+// rename(2) with flags (RENAME_NOREPLACE, RENAME_EXCHANGE): 0 or an errno.
+int RenameWithFlags(const fs::path& from, const fs::path& to,
+                    unsigned int flags) {
+  if (renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), flags) == 0) {
+    return 0;
+  }
+  return errno;
+}
+
 }  // namespace
 
 bool WriteFileAtomically(const std::string& path, const std::string& contents,
                          std::string* error) {
+  RemoveStaleSiblings(path);
   const fs::path temporary = TemporarySibling(path, "tmp");
   {
     std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
@@ -70,9 +132,18 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents,
     file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     file.close();
     if (!file) {
+      // errno of the failed write or close, e.g. ENOSPC on a full disk.
+      const int write_errno = errno;
+      const std::string reason =
+          std::strerror(write_errno) +
+          std::string(write_errno == ENOSPC
+                          ? " (free space there or choose another output "
+                            "folder)"
+                          : "");
       std::error_code ignored;
       fs::remove(temporary, ignored);
-      *error = "cannot write " + temporary.string();
+      *error = "cannot write " + temporary.string() + " (for " + path +
+               "): " + reason;
       return false;
     }
   }
@@ -99,7 +170,7 @@ void RemoveFolder(const fs::path& folder) {
 // overwrite is set) or not exist, in an existing folder.
 bool CheckOutputFolder(const std::string& output_path,
                        const OutputFolderOptions& options, fs::path* normalized,
-                       bool* exists, std::string* error) {
+                       std::string* error) {
   *normalized = Normalized(output_path);
   const fs::path& output = *normalized;
   for (const std::string& input_path : options.input_paths) {
@@ -113,8 +184,7 @@ bool CheckOutputFolder(const std::string& output_path,
   }
 
   std::error_code code;
-  *exists = fs::exists(output, code);
-  if (*exists) {
+  if (fs::exists(output, code)) {
     if (!fs::is_directory(output, code)) {
       *error = "the output path " + output_path + " exists and is not a folder";
       return false;
@@ -134,42 +204,106 @@ bool CheckOutputFolder(const std::string& output_path,
   return true;
 }
 
-// Moves the written `temporary` folder to `output`; on failure removes it
-// and restores the old output.
+// The message when another process filled the output folder while this
+// run wrote its temporary folder.
+std::string ConcurrentRunError(const std::string& output_path) {
+  return "the output folder " + output_path +
+         " was created or filled by another process while this run was "
+         "writing (two runs into the same output?); this run's output is "
+         "discarded and that folder is left as it is: choose another output "
+         "folder";
+}
+
+// Moves the written `temporary` folder to `output` in one step, so the output
+// is never partial, and never mixes two runs':
+//  - no output folder: rename with RENAME_NOREPLACE, which fails if another
+//    run created it meanwhile;
+//  - an empty one: removed (rmdir fails if another run filled it), then as
+//    above;
+//  - a non-empty one (overwrite): RENAME_EXCHANGE swaps old and new
+//    atomically, and the old one, now at the temporary name, is removed (a
+//    run killed before that leaves it to RemoveStaleSiblings).
+// File systems without these flags (EINVAL) get plain renames: the old output
+// moved aside, then the new one moved in.
 bool ReplaceOutputFolder(const fs::path& temporary, const fs::path& output,
-                         const std::string& output_path, bool output_exists,
+                         const std::string& output_path, bool allow_overwrite,
                          std::string* error) {
   std::error_code code;
-  // An empty folder in the way is replaced by the rename itself (POSIX); a
-  // non-empty one (with overwrite) is first moved aside and removed once the
-  // new folder is in place, or moved back if that fails.
-  fs::path old_output;
-  if (output_exists && !fs::is_empty(output, code)) {
-    old_output = TemporarySibling(output, "old");
-    fs::rename(output, old_output, code);
-    if (code) {
-      *error = "cannot move the old output folder " + output_path +
-               " aside: " + code.message();
+  const bool exists = fs::exists(output, code);
+  // Without overwrite, a folder filled since CheckOutputFolder is another
+  // run's: rmdir below refuses to remove it.
+  const bool overwrite =
+      allow_overwrite && exists && !fs::is_empty(output, code);
+  int result = 0;
+  if (overwrite) {
+    result = RenameWithFlags(temporary, output, RENAME_EXCHANGE);
+    if (result == EINVAL) {
+      const fs::path old_output = TemporarySibling(output, "old");
+      result = RenameWithFlags(output, old_output, 0);
+      if (result == 0) {
+        result = RenameWithFlags(temporary, output, 0);
+        if (result != 0) {
+          RenameWithFlags(old_output, output, 0);
+        } else {
+          fs::rename(old_output, temporary, code);
+        }
+      }
+    }
+  } else {
+    if (exists && rmdir(output.c_str()) != 0 && errno != ENOENT) {
+      *error = errno == ENOTEMPTY || errno == EEXIST
+                   ? ConcurrentRunError(output_path)
+                   : "cannot replace the empty output folder " + output_path +
+                         ": " + std::strerror(errno);
+      RemoveFolder(temporary);
+      return false;
+    }
+    result = RenameWithFlags(temporary, output, RENAME_NOREPLACE);
+    if (result == EINVAL) {
+      result = fs::exists(output, code) ? EEXIST
+                                        : RenameWithFlags(temporary, output, 0);
+    }
+    if (result == EEXIST || result == ENOTEMPTY) {
+      *error = ConcurrentRunError(output_path);
       RemoveFolder(temporary);
       return false;
     }
   }
-  fs::rename(temporary, output, code);
-  if (code) {
+  if (result != 0) {
     *error = "cannot rename " + temporary.string() + " to " + output_path +
-             ": " + code.message();
+             ": " + std::strerror(result);
     RemoveFolder(temporary);
-    if (!old_output.empty()) {
-      std::error_code ignored;
-      fs::rename(old_output, output, ignored);
-    }
     return false;
   }
-  if (!old_output.empty()) RemoveFolder(old_output);
+  // After an exchange the temporary name holds the old output.
+  RemoveFolder(temporary);
   return true;
 }
 
 }  // namespace
+
+bool CheckOutputFolderUsable(const std::string& output_path,
+                             const OutputFolderOptions& options,
+                             std::string* error) {
+  if (output_path.empty()) {
+    *error = "the output path is empty";
+    return false;
+  }
+  fs::path output;
+  if (!CheckOutputFolder(output_path, options, &output, error)) return false;
+  // access() reports a read-only file system (EROFS) even to root, who
+  // passes every permission check.
+  const fs::path parent =
+      output.parent_path().empty() ? fs::path(".") : output.parent_path();
+  if (access(parent.c_str(), W_OK) != 0) {
+    *error = "cannot write into " + parent.string() +
+             ", the folder that should hold the output folder " + output_path +
+             ": " + std::strerror(errno) +
+             "; choose an --output_path on a writable file system";
+    return false;
+  }
+  return true;
+}
 
 bool WriteFolderAtomically(
     const std::string& output_path, const OutputFolderOptions& options,
@@ -181,16 +315,18 @@ bool WriteFolderAtomically(
     return false;
   }
   fs::path output;
-  bool output_exists = false;
-  if (!CheckOutputFolder(output_path, options, &output, &output_exists,
-                         error)) {
+  if (!CheckOutputFolder(output_path, options, &output, error)) {
     return false;
   }
+  RemoveStaleSiblings(output);
   std::error_code code;
   const fs::path temporary = TemporarySibling(output, "tmp");
   if (!fs::create_directory(temporary, code) || code) {
-    *error = "cannot create the folder " + temporary.string() + ": " +
-             code.message();
+    *error = "cannot create the temporary folder " + temporary.string() +
+             " next to the output folder " + output_path + ": " +
+             code.message() +
+             "; the folder that holds the output must be writable (choose "
+             "another --output_path)";
     return false;
   }
   bool written = false;
@@ -204,7 +340,7 @@ bool WriteFolderAtomically(
     RemoveFolder(temporary);
     return false;
   }
-  return ReplaceOutputFolder(temporary, output, output_path, output_exists,
+  return ReplaceOutputFolder(temporary, output, output_path, options.overwrite,
                              error);
 }
 

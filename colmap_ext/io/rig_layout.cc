@@ -62,10 +62,56 @@ int FindRoot(std::vector<int>* parents, int i) {
   return i;
 }
 
+// When every image name is a number (a timestamp): " The closest images of
+// two of the groups are A and B, D apart: if they were taken together, set
+// --RigCalibrator.timestamp_tolerance to at least D." The smallest
+// difference between two sets of numbers is between neighbours in their
+// merged sorted order, so one pass over the sorted timestamps finds it.
+std::string ClosestTimestampsHint(const std::vector<std::string>& image_names,
+                                  const std::vector<std::string>& keys,
+                                  const RigLayout& layout,
+                                  const std::vector<int>& group_of) {
+  std::map<std::string, std::vector<std::pair<long double, int>>> by_folder;
+  for (size_t i = 0; i < image_names.size(); ++i) {
+    if (layout.images[i].camera_index < 0) continue;
+    TimedKey timed;
+    if (!ParseTimedKey(keys[i], &timed)) return "";
+    by_folder[timed.folder].emplace_back(timed.time, static_cast<int>(i));
+  }
+  long double best = -1;
+  int best_a = -1, best_b = -1;
+  for (auto& [folder, times] : by_folder) {
+    std::sort(times.begin(), times.end());
+    for (size_t k = 1; k < times.size(); ++k) {
+      const int a = times[k - 1].second, b = times[k].second;
+      if (group_of[layout.images[a].camera_index] ==
+          group_of[layout.images[b].camera_index]) {
+        continue;
+      }
+      const long double difference = times[k].first - times[k - 1].first;
+      if (best < 0 || difference < best) {
+        best = difference;
+        best_a = a;
+        best_b = b;
+      }
+    }
+  }
+  if (best_a < 0) return "";
+  std::ostringstream hint;
+  hint.precision(19);
+  hint << " The closest images of two of the groups are " << image_names[best_a]
+       << " and " << image_names[best_b] << ", " << best
+       << " apart (in the names' units): if they were taken together, set "
+          "--RigCalibrator.timestamp_tolerance to at least that.";
+  return hint.str();
+}
+
 // Fails unless every camera shares a frameset with the others, directly or
 // through other cameras: cam_from_rig of a camera outside the reference
 // camera's group cannot be determined.
-bool CheckCamerasConnected(const RigLayout& layout, std::string* error) {
+bool CheckCamerasConnected(const std::vector<std::string>& image_names,
+                           const std::vector<std::string>& keys,
+                           const RigLayout& layout, std::string* error) {
   const int num_cameras = static_cast<int>(layout.camera_names.size());
   std::vector<std::vector<int>> frameset_cameras(layout.frameset_names.size());
   for (const RigLayoutImage& image : layout.images) {
@@ -94,7 +140,16 @@ bool CheckCamerasConnected(const RigLayout& layout, std::string* error) {
     message << " {" << CameraList(layout.camera_prefixes, group.second) << "}";
   }
   message << "; framesets are images with the same name after the camera "
-             "prefix, or with numeric names within timestamp_tolerance";
+             "prefix, or with numeric names within "
+             "--RigCalibrator.timestamp_tolerance.";
+  std::vector<int> group_of(num_cameras);
+  for (const auto& [root, cameras] : groups) {
+    for (const int camera : cameras) group_of[camera] = root;
+  }
+  message << ClosestTimestampsHint(image_names, keys, layout, group_of);
+  message << " Name the images so that the images taken together have the "
+             "same name in every camera folder (e.g. cam0/000012.png and "
+             "cam1/000012.png), or give a tolerance for timestamp names";
   *error = message.str();
   return false;
 }
@@ -427,7 +482,7 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
   } else {
     layout->frameset_source = "identical names after the camera prefix";
   }
-  if (!CheckCamerasConnected(*layout, error)) {
+  if (!CheckCamerasConnected(image_names, keys, *layout, error)) {
     *layout = RigLayout();
     return false;
   }

@@ -94,7 +94,11 @@ void DiagnoseLocalization(const RigDataset& dataset,
                   "camera_not_in_shared_frameset",
                   "camera(s) " + CameraList(dataset, never_shared) +
                       " were localized, but never in a frameset where another "
-                      "camera was localized too: nothing ties them to the rig.",
+                      "camera was localized too: nothing ties them to the rig. "
+                      "Record framesets in which they and other cameras see "
+                      "the mapped scene together, and check that images "
+                      "taken together form one frameset (same name in every "
+                      "camera folder, or --RigCalibrator.timestamp_tolerance).",
                   never_shared);
   }
 }

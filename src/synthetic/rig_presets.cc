@@ -227,6 +227,24 @@ Rigid3d BodyFromCamera(const CameraSpec& spec) {
   return Rigid3d(body_from_cam_rotation, spec.position);
 }
 
+void ReplicateStereoPair(int num_pairs, bool alternate_facing,
+                         PresetDefinition* definition) {
+  const std::vector<CameraSpec> pair = definition->cameras;
+  definition->cameras.clear();
+  for (int k = 0; k < num_pairs; ++k) {
+    for (CameraSpec spec : pair) {
+      spec.position.z() += 0.25 * k;
+      if (alternate_facing && k % 2 == 1) {
+        // Turned by 180 degrees about the vertical: left and right swap.
+        spec.yaw_deg += 180;
+        spec.position.x() = -0.3 - spec.position.x();
+        spec.position.y() = -spec.position.y();
+      }
+      definition->cameras.push_back(spec);
+    }
+  }
+}
+
 RigGroundTruth TruthOfDefinition(const PresetDefinition& definition) {
   RigGroundTruth truth;
   const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);

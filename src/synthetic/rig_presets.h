@@ -52,6 +52,13 @@ Rigid3d BodyFromCamera(const CameraSpec& spec);
 // of that many cameras (SyntheticRigOptions::ring_num_cameras).
 PresetDefinition MakePresetDefinition(RigPreset preset, int ring_num_cameras);
 
+// Replaces the cameras of the stereo_pair definition by num_pairs copies of
+// the pair, copy k 0.25 k m above the first; with alternate_facing the odd
+// copies are turned to face backward and moved 0.3 m behind
+// (SyntheticRigOptions::stereo_num_pairs).
+void ReplicateStereoPair(int num_pairs, bool alternate_facing,
+                         PresetDefinition* definition);
+
 // The true cameras (camera ids 1, 2, ...) and extrinsics of a rig definition
 // (no rig poses); the rig frame is camera 0's.
 RigGroundTruth TruthOfDefinition(const PresetDefinition& definition);

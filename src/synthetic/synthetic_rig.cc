@@ -156,6 +156,28 @@ void GenerateImage(const SyntheticRigOptions& options,
   rig->is_outlier.push_back(std::move(shuffled_is_outlier));
 }
 
+// Changes the map's unit (SyntheticRigOptions::map_scale): x' = s x for
+// every 3D point and translation; rotations and pixels stay.
+void ScaleMap(double scale, SyntheticRig* rig) {
+  for (RigImage& image : rig->dataset.images) {
+    for (Correspondence& correspondence : image.correspondences) {
+      correspondence.point3D *= scale;
+    }
+  }
+  for (Rigid3d& pose : rig->truth.rig_from_world) pose.translation *= scale;
+  for (Rigid3d& pose : rig->truth.cam_from_rig) pose.translation *= scale;
+  for (MapImage& image : rig->dataset.map_images) {
+    image.cam_from_world.translation *= scale;
+  }
+  for (auto& [point3D_id, point3D] : rig->dataset.map_points3D) {
+    point3D *= scale;
+  }
+  for (Eigen::Vector3d& point3D : rig->true_points3D) point3D *= scale;
+  for (Rigid3d& pose : rig->true_map_cam_from_world) {
+    pose.translation *= scale;
+  }
+}
+
 }  // namespace
 
 std::string FramesetName(int frameset) {
@@ -190,6 +212,14 @@ bool SyntheticRigOptions::Check(std::string* error) const {
     message << "ring_num_cameras must be 0, or 2.." << kMaxRingCameras
             << " with the ring5 preset, got " << ring_num_cameras << " with "
             << RigPresetName(preset);
+  } else if (stereo_num_pairs < 1 || stereo_num_pairs > 8 ||
+             ((stereo_num_pairs > 1 || stereo_alternate_facing) &&
+              preset != RigPreset::kStereoPair)) {
+    message << "stereo_num_pairs must be 1..8 and stereo_num_pairs > 1 or "
+               "stereo_alternate_facing need the stereo_pair preset, got "
+            << stereo_num_pairs << " with " << RigPresetName(preset);
+  } else if (!(map_scale > 0 && std::isfinite(map_scale))) {
+    message << "map_scale must be a positive number, got " << map_scale;
   } else if (!(feature_window > 0 && feature_window <= 1)) {
     message << "feature_window must be in (0, 1], got " << feature_window;
   } else if (num_map_images < 0 || !(map_noise_px >= 0) ||
@@ -216,14 +246,22 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
   // images, then per image (frameset-major) its window, points, wrong
   // matches, order and noise.
   std::mt19937 rng(options.seed);
-  const PresetDefinition definition =
+  PresetDefinition definition =
       MakePresetDefinition(options.preset, options.ring_num_cameras);
+  if (options.stereo_num_pairs > 1 || options.stereo_alternate_facing) {
+    ReplicateStereoPair(options.stereo_num_pairs,
+                        options.stereo_alternate_facing, &definition);
+  }
   rig.truth = TruthOfDefinition(definition);
   const int num_cameras = rig.truth.cameras.size();
 
   const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);
-  for (const Rigid3d& world_from_body :
-       MakeTrajectory(definition.motion, options.num_framesets, &rng)) {
+  std::vector<Rigid3d> trajectory =
+      MakeTrajectory(definition.motion, options.num_framesets, &rng);
+  for (Rigid3d& world_from_body : trajectory) {
+    if (options.rotation_only) {
+      world_from_body.translation = trajectory.front().translation;
+    }
     rig.truth.rig_from_world.push_back(
         (world_from_body * body_from_rig).Inverse());
   }
@@ -258,6 +296,7 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
   // A separate random stream, so that the rig images stay those of earlier
   // versions for the same seed.
   AddSyntheticMap(options, &rig);
+  if (options.map_scale != 1.0) ScaleMap(options.map_scale, &rig);
   return rig;
 }
 

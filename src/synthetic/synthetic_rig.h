@@ -90,6 +90,19 @@ struct SyntheticRigOptions {
   int num_map_images = 0;
   double map_noise_px = 0.5;
   double map_point_noise = 0.0;
+  // stereo_pair only: that many copies of the pair, copy k 0.25 k m above
+  // the first (several pairs facing the same way: all principal axes
+  // parallel); with stereo_alternate_facing the odd copies face backward,
+  // 0.3 m behind (front/rear pairs: parallel and anti-parallel axes).
+  int stereo_num_pairs = 1;
+  bool stereo_alternate_facing = false;
+  // The rig only rotates about a fixed point: every frameset's rig center is
+  // the first one's (no translation between framesets).
+  bool rotation_only = false;
+  // Map units per metre: every map point and translation (rig poses,
+  // cam_from_rig) is multiplied by it, pixels are unchanged. E.g. 1000 for a
+  // map in millimetres; the calibration must be the same up to this scale.
+  double map_scale = 1.0;
   unsigned int seed = 0;
 
   // False (with a message) for values outside their ranges.

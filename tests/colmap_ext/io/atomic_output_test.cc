@@ -1,6 +1,8 @@
 #include "colmap_ext/io/atomic_output.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -121,6 +123,98 @@ TEST(AtomicOutput, FailedOverwriteKeepsTheOldOutput) {
   EXPECT_EQ(testing::ReadBytes(output + "/old.txt"), "old");
   EXPECT_EQ(testing::ReadBytes(output + "/a.txt"), "a");
   EXPECT_EQ(NumEntries(output), 3u);
+  EXPECT_EQ(NumEntries(dir.path()), 1u);
+}
+
+// Another process creating or filling the output folder while this one
+// writes (two runs into one output): the later rename fails, the other's
+// output stays as it is, nothing is mixed and no temporary folder is left.
+TEST(AtomicOutput, OutputCreatedMeanwhileIsNotReplaced) {
+  for (const bool output_existed_empty : {false, true}) {
+    testing::ScopedTempDir dir;
+    const std::string output = dir.File("out");
+    if (output_existed_empty) fs::create_directories(output);
+    std::string error;
+    EXPECT_FALSE(WriteFolderAtomically(
+        output, OutputFolderOptions(),
+        [&](const std::string& folder, std::string* error) {
+          fs::create_directories(output);
+          std::ofstream(output + "/other.txt") << "other run";
+          return WriteTwoFiles(folder, error);
+        },
+        &error));
+    EXPECT_NE(error.find("was created or filled by another process while this "
+                         "run was writing (two runs into the same output?)"),
+              std::string::npos)
+        << error;
+    EXPECT_EQ(testing::ReadBytes(output + "/other.txt"), "other run");
+    EXPECT_EQ(NumEntries(output), 1u);
+    EXPECT_EQ(NumEntries(dir.path()), 1u);
+  }
+}
+
+// A pid that no process has: a child that has exited and been reaped.
+pid_t DeadProcessId() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, nullptr, 0);
+  return child;
+}
+
+// Temporary folders of killed runs (kill -9) are removed by the next run
+// into the same output; those of running processes are kept.
+TEST(AtomicOutput, StaleTemporaryFoldersOfDeadRunsAreRemoved) {
+  testing::ScopedTempDir dir;
+  const std::string dead = std::to_string(DeadProcessId());
+  const std::string alive = std::to_string(getppid());
+  for (const std::string& name :
+       {".out.tmp-" + dead + "-12345", ".out.old-" + dead + "-7",
+        ".out.tmp-" + alive + "-1", ".other.tmp-" + dead + "-1",
+        ".out.tmp-x" + dead + "-1"}) {
+    fs::create_directories(dir.File(name));
+    std::ofstream(dir.File(name) + "/partial.txt") << "partial";
+  }
+  std::string error;
+  ::testing::internal::CaptureStdout();
+  ASSERT_TRUE(WriteFolderAtomically(dir.File("out"), OutputFolderOptions(),
+                                    WriteTwoFiles, &error))
+      << error;
+  const std::string log = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(log.find(".out.tmp-" + dead +
+                     "-12345, left by an interrupted "
+                     "run (its process no longer exists)"),
+            std::string::npos)
+      << log;
+  EXPECT_FALSE(fs::exists(dir.File(".out.tmp-" + dead + "-12345")));
+  EXPECT_FALSE(fs::exists(dir.File(".out.old-" + dead + "-7")));
+  EXPECT_TRUE(fs::exists(dir.File(".out.tmp-" + alive + "-1")));
+  EXPECT_TRUE(fs::exists(dir.File(".other.tmp-" + dead + "-1")));
+  EXPECT_TRUE(fs::exists(dir.File(".out.tmp-x" + dead + "-1")));
+  EXPECT_EQ(NumEntries(dir.path()), 4u);
+
+  // The same for the temporary file of a single file.
+  std::ofstream(dir.File(".f.txt.tmp-" + dead + "-3")) << "partial";
+  ASSERT_TRUE(WriteFileAtomically(dir.File("f.txt"), "f", &error)) << error;
+  EXPECT_FALSE(fs::exists(dir.File(".f.txt.tmp-" + dead + "-3")));
+  EXPECT_EQ(NumEntries(dir.path()), 5u);
+}
+
+// The early check of the command: a read-only file system is reported
+// before any work (here a missing parent and a non-empty folder; the
+// read-only case needs a mount: output_faults_test.sh).
+TEST(AtomicOutput, UsableCheckGivesTheWritersMessages) {
+  testing::ScopedTempDir dir;
+  std::string error;
+  EXPECT_TRUE(
+      CheckOutputFolderUsable(dir.File("out"), OutputFolderOptions(), &error));
+  EXPECT_FALSE(CheckOutputFolderUsable(dir.File("no/out"),
+                                       OutputFolderOptions(), &error));
+  EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+  fs::create_directories(dir.File("full"));
+  std::ofstream(dir.File("full/a.txt")) << "a";
+  EXPECT_FALSE(
+      CheckOutputFolderUsable(dir.File("full"), OutputFolderOptions(), &error));
+  EXPECT_NE(error.find("pass --overwrite"), std::string::npos) << error;
   EXPECT_EQ(NumEntries(dir.path()), 1u);
 }
 

@@ -153,6 +153,60 @@ TEST(RigLayout, NanosecondTimestampsWithinTolerance) {
   EXPECT_NE(error.find("never share a frameset"), std::string::npos) << error;
 }
 
+// Degenerate data (issue 15): timestamps that do not match within the
+// tolerance (cam1's clock 12 ms behind cam0's, the tolerance 5 ms) leave the
+// cameras without a common frameset. The error names the groups, the closest
+// pair of images and the tolerance that would pair them, and what to do.
+TEST(RigLayout, TimestampsOutsideTheToleranceAreDiagnosed) {
+  const std::vector<std::string> names = {
+      "cam0/1403715273262142976.png", "cam1/1403715273274142976.png",
+      "cam0/1403715273312142976.png", "cam1/1403715273324142976.png",
+      "cam2/1403715273262142976.png"};
+  RigLayoutOptions options;
+  options.timestamp_tolerance = 5e6;
+  RigLayout layout;
+  std::string error;
+  EXPECT_FALSE(DiscoverRigLayout(names, options, &layout, &error));
+  EXPECT_NE(error.find("the cameras fall into 2 groups that never share a "
+                       "frameset: {cam0/, cam2/} {cam1/}"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("The closest images of two of the groups are "
+                       "cam2/1403715273262142976.png and "
+                       "cam1/1403715273274142976.png, 12000000 apart"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("set --RigCalibrator.timestamp_tolerance to at least"),
+            std::string::npos)
+      << error;
+  EXPECT_TRUE(layout.images.empty());
+  // With the suggested tolerance they pair up.
+  options.timestamp_tolerance = 12e6;
+  ASSERT_TRUE(DiscoverRigLayout(names, options, &layout, &error)) << error;
+  EXPECT_EQ(layout.frameset_names.size(), 2u);
+}
+
+// A camera never in a frameset with the others (its images named apart):
+// named, with what to do, and no timestamp hint for names that are not
+// numbers.
+TEST(RigLayout, CameraNeverInAFramesetWithTheOthersIsDiagnosed) {
+  const std::vector<std::string> names = {
+      "cam0/frame_1.png", "cam1/frame_1.png", "cam0/frame_2.png",
+      "cam1/frame_2.png", "cam2/img_1.png",   "cam2/img_2.png"};
+  RigLayout layout;
+  std::string error;
+  EXPECT_FALSE(DiscoverRigLayout(names, RigLayoutOptions(), &layout, &error));
+  EXPECT_NE(error.find("2 groups that never share a frameset: {cam0/, cam1/} "
+                       "{cam2/}"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("Name the images so that the images taken together "
+                       "have the same name in every camera folder"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(error.find("closest images"), std::string::npos) << error;
+}
+
 TEST(RigLayout, TimestampClustersTakeOneImagePerCamera) {
   // With a tolerance wider than the frame period, a camera's second image
   // starts a new frameset instead of joining the first.

@@ -576,3 +576,72 @@ TEST(SyntheticRig, RingWithNCameras) {
 
 }  // namespace
 }  // namespace rig_calibrator
+
+namespace rig_calibrator {
+namespace {
+
+// Degenerate rigs (issue 15): several stereo pairs, facing one way or
+// alternately forward and backward.
+TEST(SyntheticRig, StereoPairsFaceForwardOrAlternately) {
+  SyntheticRigOptions options = SmallOptions(RigPreset::kStereoPair);
+  options.stereo_num_pairs = 2;
+  for (const bool alternate : {false, true}) {
+    options.stereo_alternate_facing = alternate;
+    const SyntheticRig rig = GenerateSyntheticRig(options);
+    ASSERT_EQ(rig.truth.cameras.size(), 4u);
+    for (int c = 1; c < 4; ++c) {
+      const double angle = RotationDifferenceDeg(
+          Eigen::Quaterniond::Identity(), rig.truth.cam_from_rig[c].rotation);
+      EXPECT_NEAR(angle, alternate && c >= 2 ? 180 : 0, 0.5) << c;
+    }
+    // The second pair 0.25 m above the first (camera y points down), 0.3 m
+    // behind when it faces backward.
+    const Eigen::Vector3d center = rig.truth.cam_from_rig[2].Center();
+    EXPECT_NEAR(center.y(), -0.25, 1e-9);
+    EXPECT_NEAR(center.z(), alternate ? -0.3 : 0, 1e-9);
+    std::string error;
+    EXPECT_TRUE(options.Check(&error)) << error;
+  }
+  options.preset = RigPreset::kRing5;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("need the stereo_pair preset"), std::string::npos);
+}
+
+// rotation_only keeps the body (ring center) at one point; map_scale scales
+// every 3D point and translation and leaves the pixels bit for bit.
+TEST(SyntheticRig, RotationOnlyAndMapScale) {
+  SyntheticRigOptions options = SmallOptions(RigPreset::kRing5);
+  options.rotation_only = true;
+  const SyntheticRig rig = GenerateSyntheticRig(options);
+  // Camera 0 is 0.15 m from the fixed ring center, so the rig origin moves
+  // on a sphere of that radius.
+  const Eigen::Vector3d center0 =
+      rig.truth.rig_from_world[0].Inverse().translation;
+  for (const Rigid3d& rig_from_world : rig.truth.rig_from_world) {
+    EXPECT_LT((rig_from_world.Inverse().translation - center0).norm(),
+              0.3 + 1e-9);
+  }
+  options.map_scale = 1000;
+  const SyntheticRig scaled = GenerateSyntheticRig(options);
+  ASSERT_EQ(scaled.dataset.images.size(), rig.dataset.images.size());
+  for (size_t i = 0; i < rig.dataset.images.size(); ++i) {
+    const auto& a = rig.dataset.images[i].correspondences;
+    const auto& b = scaled.dataset.images[i].correspondences;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].point2D, b[k].point2D);
+      EXPECT_EQ(1000 * a[k].point3D, b[k].point3D);
+    }
+  }
+  for (size_t c = 0; c < rig.truth.cam_from_rig.size(); ++c) {
+    EXPECT_EQ(1000 * rig.truth.cam_from_rig[c].translation,
+              scaled.truth.cam_from_rig[c].translation);
+  }
+  options.map_scale = 0;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+}
+
+}  // namespace
+}  // namespace rig_calibrator
