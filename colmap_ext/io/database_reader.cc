@@ -419,7 +419,9 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
   }
   const int64_t rows = blob.rows;
   const int64_t cols = blob.cols;
+  // rows > num_bytes first: the product could overflow.
   if (rows < 0 || (rows > 0 && cols != 2 && cols != 4 && cols != 6) ||
+      rows > blob.num_bytes ||
       blob.num_bytes != rows * cols * static_cast<int64_t>(sizeof(float))) {
     *error = what + " are malformed " + blob.ShapeText();
     return false;
@@ -456,7 +458,8 @@ bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
              " dimensions; rig_calibrator matches 128-dimensional SIFT";
     return false;
   }
-  if (blob.rows < 0 || blob.num_bytes != blob.rows * blob.cols) {
+  if (blob.rows < 0 || blob.rows > blob.num_bytes ||
+      blob.num_bytes != blob.rows * blob.cols) {
     *error = what + " are malformed " + blob.ShapeText();
     return false;
   }
@@ -481,7 +484,7 @@ bool DatabaseReader::ReadInlierMatches(const colmap::image_t image_id1,
   const BlobMatrix blob = BlobMatrix::OfRow(read_inlier_matches_);
   const int64_t rows = blob.rows;
   if (rows <= 0) return true;
-  if (blob.cols != 2 ||
+  if (blob.cols != 2 || rows > blob.num_bytes ||
       blob.num_bytes != rows * 2 * static_cast<int64_t>(sizeof(uint32_t))) {
     *error = "database " + path_ + ": inlier matches of " +
              ImageLabel(image_id1) + " and " + ImageLabel(image_id2) +
