@@ -9,6 +9,8 @@
 #include <fstream>
 #include <functional>
 
+#include "colmap_ext/io/model_unique_ids.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -262,7 +264,10 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              " (not a COLMAP 3.8 text model?): " + exception.what();
     return false;
   }
-  if (!CheckReferences(path, *map, error)) return false;
+  if (!CheckUniqueModelIds(path, binary, *map, error) ||
+      !CheckReferences(path, *map, error)) {
+    return false;
+  }
   if (map->NumRegImages() == 0) {
     *error = "the map in " + path + " has no registered image";
     return false;

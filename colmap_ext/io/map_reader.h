@@ -14,8 +14,8 @@ namespace rig_calibrator {
 // .txt). Fails with a message if the folder or a file is missing or
 // unreadable, a binary file's records do not fit its size exactly, a camera
 // model is unknown to COLMAP 3.8 or has the wrong number of parameters, a text
-// file does not parse, images, cameras and points refer to each other
-// inconsistently, or the model has no registered image or no 3D point.
+// file does not parse, an id repeats, images, cameras and points refer to each
+// other inconsistently, or the model has no registered image or no 3D point.
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              std::string* error);
 

@@ -143,7 +143,7 @@ TEST(InputLimits, CorrespondenceNonFiniteNumbersAreRefused) {
 // --- binary model files -----------------------------------------------------
 
 // A model with one camera, one registered image with one point2D, one point.
-void WriteModel(const std::string& folder) {
+colmap::Reconstruction TestModel() {
   colmap::Reconstruction model;
   colmap::Camera camera;
   camera.InitializeWithName("SIMPLE_RADIAL", 500, 640, 480);
@@ -161,8 +161,10 @@ void WriteModel(const std::string& folder) {
   colmap::Track track;
   track.AddElement(1, 0);
   model.AddPoint3D(Eigen::Vector3d(0, 0, 4), track);
-  model.WriteBinary(folder);
+  return model;
 }
+
+void WriteModel(const std::string& folder) { TestModel().WriteBinary(folder); }
 
 // A 100-byte file: `head`, then zeros.
 std::string HundredBytes(const std::string& head) {
@@ -190,7 +192,8 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
   EXPECT_EQ(MapError(folder),
             prefix +
                 "points3D.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): it ends inside a point record");
+                "COLMAP 3.8): a point record claims 1 entries, more "
+                "than the 41 bytes left can hold");
   // One point whose track claims 10^12 elements.
   WriteBytes(prefix + "points3D.bin",
              HundredBytes(Binary<uint64_t>(1) +
@@ -199,7 +202,7 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
             prefix +
                 "points3D.bin is not a COLMAP binary model file (of "
                 "COLMAP 3.8): a point's track claims 1000000000000 "
-                "entries, more than the 39 bytes left can hold");
+                "entries, more than the 41 bytes left can hold");
   WriteModel(folder);
 
   // One image claiming 10^12 points2D.
@@ -213,14 +216,58 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
                 "entries, more than the 14 bytes left can hold");
   WriteModel(folder);
 
-  // 10^12 cameras.
+  // 10^12 cameras: the second record (zeros: a camera of model 0,
+  // SIMPLE_PINHOLE) does not fit.
   WriteBytes(
       prefix + "cameras.bin",
       HundredBytes(Binary(huge) + Binary<uint32_t>(1) + Binary<int32_t>(2)));
   EXPECT_EQ(MapError(folder),
             prefix +
                 "cameras.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): it ends inside a camera model id");
+                "COLMAP 3.8): camera parameters claims 3 entries, "
+                "more than the 12 bytes left can hold");
+}
+
+// COLMAP 3.8 keeps the first record of an id and drops the others (and
+// registers a repeated images.txt record twice): the model is refused.
+TEST(InputLimits, RepeatedModelIdsAreRefused) {
+  testing::ScopedTempDir dir;
+  const std::string folder = dir.path();
+  const std::string prefix = folder + "/";
+  TestModel().WriteText(folder);
+  const std::string images = testing::ReadBytes(prefix + "images.txt");
+  const size_t record = images.find("\n1 ") + 1;
+  WriteBytes(prefix + "images.txt", images + images.substr(record));
+  EXPECT_EQ(MapError(folder),
+            prefix +
+                "images.txt has 2 image records but 1 distinct image "
+                "ids (1 appears twice): every image id must be unique "
+                "(COLMAP would keep only the first record)");
+
+  TestModel().WriteText(folder);
+  const std::string points = testing::ReadBytes(prefix + "points3D.txt");
+  const std::string point_line = points.substr(points.find("\n1 ") + 1);
+  WriteBytes(prefix + "points3D.txt", points + point_line);
+  EXPECT_EQ(MapError(folder),
+            prefix +
+                "points3D.txt has 2 point records but 1 distinct point "
+                "ids (1 appears twice): every point id must be unique "
+                "(COLMAP would keep only the first record)");
+}
+
+TEST(InputLimits, RepeatedBinaryModelIdsAreRefused) {
+  testing::ScopedTempDir dir;
+  const std::string folder = dir.path();
+  const std::string prefix = folder + "/";
+  WriteModel(folder);
+  const std::string points = testing::ReadBytes(prefix + "points3D.bin");
+  WriteBytes(prefix + "points3D.bin",
+             Binary<uint64_t>(2) + points.substr(8) + points.substr(8));
+  EXPECT_EQ(MapError(folder),
+            prefix +
+                "points3D.bin has 2 point records but 1 distinct point "
+                "ids: every point id must be unique (COLMAP would keep "
+                "only the first record)");
 }
 
 // --- database blobs ---------------------------------------------------------
