@@ -4,6 +4,8 @@
 # $RIG_CALIBRATOR_SANITIZE_BUILD_DIR) and runs every test (unit and e2e) there.
 # Any ASan or UBSan report fails the test that triggered it. Extra arguments go
 # to ctest (e.g. -LE e2e for the unit tests only).
+#   RIG_CALIBRATOR_SANITIZE_TARGETS="input_limits_test database_reader_test"
+#   builds (and so runs) only those test executables.
 #
 # Our code is instrumented; COLMAP's, Ceres' and the system's libraries are
 # not, so a bug inside them is out of reach, but every access our code makes
@@ -34,7 +36,12 @@ run_step "configure ($sanitize_build)" \
   cmake -S "$repo" -B "$sanitize_build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_PREFIX_PATH="$cache/colmap-3.8" -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
-run_step "build (ASan + UBSan)" cmake --build "$sanitize_build" -j"$jobs"
+targets=()
+for target in ${RIG_CALIBRATOR_SANITIZE_TARGETS:-}; do
+  targets+=(--target "$target")
+done
+run_step "build (ASan + UBSan)" cmake --build "$sanitize_build" -j"$jobs" \
+  "${targets[@]}"
 run_step "ctest (ASan + UBSan)" \
   bash -c "cd '$sanitize_build' && ctest --output-on-failure -j'$jobs' $*"
 print_timings "$start"

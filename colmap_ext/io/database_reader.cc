@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -430,6 +431,14 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
   keypoints->resize(rows);
   for (int64_t i = 0; i < rows; ++i) {
     const float* row = data + i * cols;
+    // COLMAP's FeatureKeypoint aborts on a negative scale (CHECK).
+    if (!std::all_of(row, row + cols,
+                     [](float v) { return std::isfinite(v); }) ||
+        (cols == 4 && row[2] < 0)) {
+      *error = what + " are malformed: keypoint " + std::to_string(i) +
+               " has a non-finite value or a negative scale";
+      return false;
+    }
     if (cols == 2) {
       (*keypoints)[i] = colmap::FeatureKeypoint(row[0], row[1]);
     } else if (cols == 4) {

@@ -18,14 +18,17 @@ void RemoveScratchFolder() {
 }  // namespace
 
 const std::string& ScratchFolder() {
-  static const std::string folder = [] {
+  // Never destroyed: RemoveScratchFolder runs at exit, after the destructors
+  // of the statics constructed before it was registered.
+  static const std::string* const folder = [] {
     std::string pattern =
         (fs::temp_directory_path() / "rig_calibrator_fuzz.XXXXXX").string();
     if (mkdtemp(pattern.data()) == nullptr) std::abort();
-    std::atexit(RemoveScratchFolder);
-    return pattern;
+    return new std::string(pattern);
   }();
-  return folder;
+  static const bool registered = std::atexit(RemoveScratchFolder) == 0;
+  (void)registered;
+  return *folder;
 }
 
 std::string WriteScratchFile(const std::string& name, const uint8_t* data,

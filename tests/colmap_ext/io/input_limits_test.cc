@@ -9,8 +9,11 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <utility>
 
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/database_reader.h"
@@ -324,6 +327,51 @@ TEST(InputLimits, DatabaseBlobShapesBeyondTheBlobAreRefused) {
                        "cam0/0001.png (id 2)"),
             std::string::npos)
       << error;
+}
+
+// Found by database_blob_fuzzer: a keypoint of 4 floats with a negative
+// scale made COLMAP's FeatureKeypoint end the process (CHECK_GE(scale, 0));
+// NaN or infinite keypoints would reach the calibration.
+TEST(InputLimits, DatabaseKeypointsWithNegativeScaleOrNanAreRefused) {
+  testing::ScopedTempDir dir;
+  const std::string path = dir.File("database.db");
+  {
+    colmap::Database database(path);
+    colmap::Camera camera;
+    camera.InitializeWithName("SIMPLE_RADIAL", 300, 64, 48);
+    colmap::Image image;
+    image.SetName("cam0/0001.png");
+    image.SetCameraId(database.WriteCamera(camera));
+    database.WriteKeypoints(database.WriteImage(image),
+                            colmap::FeatureKeypoints(2));
+  }
+  // Two keypoints (x, y, scale, orientation); the second's scale is -7.
+  const float negative_scale[8] = {1, 2, 1.5f, 0, 3, 4, -7, 0};
+  const float nan_x[4] = {std::numeric_limits<float>::quiet_NaN(), 2, 1.5f, 0};
+  for (const auto& [values, num_rows] :
+       {std::pair<const float*, int>(negative_scale, 2), {nan_x, 1}}) {
+    std::string hex;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(values);
+    for (int i = 0; i < num_rows * 16; ++i) {
+      char digits[3];
+      std::snprintf(digits, sizeof(digits), "%02X", bytes[i]);
+      hex += digits;
+    }
+    testing::ExecuteSql(
+        path, "UPDATE keypoints SET rows = " + std::to_string(num_rows) +
+                  ", cols = 4, data = X'" + hex + "';");
+    DatabaseReader reader;
+    std::string error;
+    ASSERT_TRUE(reader.Open(path, &error)) << error;
+    colmap::FeatureKeypoints keypoints;
+    EXPECT_FALSE(reader.ReadKeypoints(1, &keypoints, &error));
+    EXPECT_NE(error.find("keypoints of image cam0/0001.png (id 1) are "
+                         "malformed: keypoint " +
+                         std::to_string(num_rows - 1) +
+                         " has a non-finite value or a negative scale"),
+              std::string::npos)
+        << error;
+  }
 }
 
 }  // namespace
