@@ -43,6 +43,6 @@ done
 run_step "build (ASan + UBSan)" cmake --build "$sanitize_build" -j"$jobs" \
   "${targets[@]}"
 run_step "ctest (ASan + UBSan)" \
-  bash -c "cd '$sanitize_build' && ctest --output-on-failure -j'$jobs' $*"
+  ctest --test-dir "$sanitize_build" --output-on-failure -j"$jobs" "$@"
 print_timings "$start"
 echo "[$log_tag] done: no sanitizer report, every test passed"
