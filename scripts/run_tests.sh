@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# The test command: sets up dependencies, builds, and runs the whole suite with ctest.
+# The test command: sets up dependencies, builds, and runs the whole suite with
+# ctest, then every fuzz target for a short time (scripts/fuzz.sh,
+# $RIG_CALIBRATOR_FUZZ_SECONDS seconds each, default 15; 0 skips it).
 set -euo pipefail
 
 log_tag=run_tests
@@ -10,3 +12,7 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 bash "$repo/scripts/build.sh"
 cd "$build"
 ctest --output-on-failure -j"$jobs" "$@"
+fuzz_seconds="${RIG_CALIBRATOR_FUZZ_SECONDS:-15}"
+if [[ "$fuzz_seconds" != 0 ]]; then
+  bash "$repo/scripts/fuzz.sh" "$fuzz_seconds"
+fi

@@ -35,6 +35,9 @@ packages=(
   libboost-regex-dev libboost-system-dev libboost-test-dev
   libgtest-dev googletest sqlite3 python3 python3-numpy nlohmann-json3-dev libyaml-cpp-dev
   ccache
+  # scripts/fuzz.sh: clang (14 in bookworm), the runtimes of libFuzzer and
+  # the sanitizers, and clang's OpenMP (COLMAP's headers need OpenMP).
+  clang libclang-rt-14-dev libomp-14-dev
 )
 
 missing_packages() {

@@ -228,6 +228,19 @@ bool SetKnownIntrinsics(const CalibrateOptions& options,
     if (intrinsics.Width() == 0) {
       intrinsics.SetWidth(camera.camera.Width());
       intrinsics.SetHeight(camera.camera.Height());
+    } else if (intrinsics.Width() != camera.camera.Width() ||
+               intrinsics.Height() != camera.camera.Height()) {
+      // Focal length and principal point are in pixels of that size.
+      *error = "the intrinsics of camera " + camera.name + " (" +
+               (options.intrinsics_path.empty() ? "database"
+                                                : options.intrinsics_path) +
+               ") are for " + std::to_string(intrinsics.Width()) + "x" +
+               std::to_string(intrinsics.Height()) +
+               " images, but its images are " +
+               std::to_string(camera.camera.Width()) + "x" +
+               std::to_string(camera.camera.Height()) +
+               ": give intrinsics calibrated at the images' size";
+      return false;
     }
     camera.camera = intrinsics;
     camera.intrinsics_known = true;

@@ -1,5 +1,6 @@
 #include "colmap_ext/io/correspondence_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -14,6 +15,17 @@ namespace rig_calibrator {
 namespace {
 
 bool IsSpace(char c) { return c == ' ' || c == '\t'; }
+
+// The shortest row, "0 0 0 0 0" and its line break: a file of B more bytes
+// holds at most (B + 1) / kMinRowBytes rows (the last one without a break).
+constexpr int64_t kMinRowBytes = 10;
+
+// A field quoted in a message: at most 40 bytes of it.
+std::string Quote(std::string_view field) {
+  constexpr size_t kMaxQuoted = 40;
+  return "'" + std::string(field.substr(0, kMaxQuoted)) +
+         (field.size() > kMaxQuoted ? "...'" : "'");
+}
 
 std::vector<std::string_view> SplitWhitespace(std::string_view line) {
   std::vector<std::string_view> tokens;
@@ -73,6 +85,13 @@ bool ParseImageLine(std::string_view line, const LineError& fail,
       tokens[n - 4].data() + tokens[n - 4].size() - line.data();
   image->image_name =
       std::string(line.substr(name_begin, name_end - name_begin));
+  // No file name holds a NUL byte; any other byte (e.g. a name that is not
+  // UTF-8) is kept as it is, as COLMAP keeps it.
+  if (image->image_name.find('\0') != std::string::npos) {
+    return fail(
+        "the image name " + Quote(image->image_name) + " contains a NUL byte",
+        error);
+  }
   image->width = static_cast<int>(width);
   image->height = static_cast<int>(height);
   return true;
@@ -89,8 +108,8 @@ bool ParseRow(std::string_view line, const LineError& fail,
   double values[5];
   for (int i = 0; i < 5; ++i) {
     if (!ParseDouble(tokens[i], &values[i])) {
-      return fail("field " + std::to_string(i + 1) + " '" +
-                      std::string(tokens[i]) + "' is not a finite number",
+      return fail("field " + std::to_string(i + 1) + " " + Quote(tokens[i]) +
+                      " is not a finite number",
                   error);
     }
   }
@@ -100,9 +119,9 @@ bool ParseRow(std::string_view line, const LineError& fail,
   if (tokens.size() == 6 &&
       (!ParseInt64(tokens[5], &correspondence->point3D_id) ||
        correspondence->point3D_id < -1)) {
-    return fail("the point3D_id '" + std::string(tokens[5]) +
-                    "' is not an integer >= -1",
-                error);
+    return fail(
+        "the point3D_id " + Quote(tokens[5]) + " is not an integer >= -1",
+        error);
   }
   return true;
 }
@@ -118,6 +137,11 @@ bool ReadCorrespondenceFile(const std::string& path,
     *error = "cannot open the correspondence file " + path;
     return false;
   }
+  file.seekg(0, std::ios::end);
+  const int64_t file_size = file.tellg();
+  file.seekg(0);
+  // Bytes read so far, line breaks included.
+  int64_t position = 0;
   std::unordered_set<std::string> names;
   int64_t rows_left = 0;
   int line_number = 0;
@@ -125,6 +149,7 @@ bool ReadCorrespondenceFile(const std::string& path,
   std::string line;
   while (std::getline(file, line)) {
     ++line_number;
+    position += static_cast<int64_t>(line.size()) + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const LineError fail(path, line_number);
     const std::vector<std::string_view> tokens = SplitWhitespace(line);
@@ -148,7 +173,11 @@ bool ReadCorrespondenceFile(const std::string& path,
       if (!names.insert(image.image_name).second) {
         return fail("the image " + image.image_name + " appears twice", error);
       }
-      image.correspondences.reserve(rows_left);
+      // Room for the rows that the rest of the file can hold, not for what
+      // the line claims: a count beyond them fails when the file ends.
+      const int64_t bytes_left = std::max<int64_t>(file_size - position, 0);
+      image.correspondences.reserve(
+          std::min(rows_left, (bytes_left + 1) / kMinRowBytes));
       images->push_back(std::move(image));
       image_line_number = line_number;
       continue;

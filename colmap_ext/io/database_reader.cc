@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -629,7 +630,9 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
   }
   const int64_t rows = blob.rows;
   const int64_t cols = blob.cols;
+  // rows > num_bytes first: the product could overflow.
   if (rows < 0 || (rows > 0 && cols != 2 && cols != 4 && cols != 6) ||
+      rows > blob.num_bytes ||
       blob.num_bytes != rows * cols * static_cast<int64_t>(sizeof(float))) {
     *error = what + " are malformed " + blob.ShapeText();
     return false;
@@ -638,6 +641,14 @@ bool DatabaseReader::ReadKeypoints(const colmap::image_t image_id,
   keypoints->resize(rows);
   for (int64_t i = 0; i < rows; ++i) {
     const float* row = data + i * cols;
+    // COLMAP's FeatureKeypoint aborts on a negative scale (CHECK).
+    if (!std::all_of(row, row + cols,
+                     [](float v) { return std::isfinite(v); }) ||
+        (cols == 4 && row[2] < 0)) {
+      *error = what + " are malformed: keypoint " + std::to_string(i) +
+               " has a non-finite value or a negative scale";
+      return false;
+    }
     if (cols == 2) {
       (*keypoints)[i] = colmap::FeatureKeypoint(row[0], row[1]);
     } else if (cols == 4) {
@@ -675,7 +686,8 @@ bool DatabaseReader::ReadDescriptors(const colmap::image_t image_id,
              " dimensions; rig_calibrator matches 128-dimensional SIFT";
     return false;
   }
-  if (blob.rows < 0 || blob.num_bytes != blob.rows * blob.cols) {
+  if (blob.rows < 0 || blob.rows > blob.num_bytes ||
+      blob.num_bytes != blob.rows * blob.cols) {
     *error = what + " are malformed " + blob.ShapeText();
     return false;
   }
@@ -700,7 +712,7 @@ bool DatabaseReader::ReadInlierMatches(const colmap::image_t image_id1,
   const BlobMatrix blob = BlobMatrix::OfRow(read_inlier_matches_);
   const int64_t rows = blob.rows;
   if (rows <= 0) return true;
-  if (blob.cols != 2 ||
+  if (blob.cols != 2 || rows > blob.num_bytes ||
       blob.num_bytes != rows * 2 * static_cast<int64_t>(sizeof(uint32_t))) {
     *error = "database " + path_ + ": inlier matches of " +
              ImageLabel(image_id1) + " and " + ImageLabel(image_id2) +

@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "colmap_ext/io/colmap_camera_models.h"
+#include "colmap_ext/io/model_unique_ids.h"
 #include "colmap_ext/io/rigs_frames_io.h"
 
 namespace rig_calibrator {
@@ -429,6 +430,7 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
     return false;
   }
   if (!ReadWithColmap(folder, binary, cameras, map, info, error) ||
+      !CheckUniqueModelIds(path, binary, *map, error) ||
       !CheckReferences(path, *map, error) ||
       !ReadMapRigsAndFrames(path, binary, *map, info, error)) {
     return false;

@@ -47,9 +47,10 @@ struct MapReadInfo {
 // .txt; rigs and frames if present). Fails with a message if the folder or a
 // file is missing or unreadable, a binary file's records do not fit its size
 // exactly, a camera model is unknown to every COLMAP up to 4.1 or has the
-// wrong number of parameters, a text file does not parse, images, cameras and
-// points refer to each other inconsistently, the rigs and frames disagree
-// with the images, or the model has no registered image or no 3D point.
+// wrong number of parameters, a text file does not parse, an id repeats,
+// images, cameras and points refer to each other inconsistently, the rigs and
+// frames disagree with the images, or the model has no registered image or no
+// 3D point.
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              MapReadInfo* info, std::string* error);
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,

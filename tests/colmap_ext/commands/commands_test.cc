@@ -189,6 +189,60 @@ TEST_F(CommandsTest, KnownMethodWithIntrinsicsFile) {
   EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
 }
 
+// Intrinsics of another image size, and images of one camera folder with
+// different sizes, are refused by name.
+TEST_F(CommandsTest, ImagesWhoseSizeDiffersFromTheirCameraAreRefused) {
+  std::string camchain =
+      testing::ReadBytes(data_ + "/ground_truth/camchain.yaml");
+  const size_t resolution = camchain.find("resolution: [");
+  ASSERT_NE(resolution, std::string::npos);
+  const size_t width_begin = resolution + std::string("resolution: [").size();
+  const size_t width_end = camchain.find(',', width_begin);
+  const std::string width =
+      camchain.substr(width_begin, width_end - width_begin);
+  camchain.replace(width_begin, width_end - width_begin,
+                   std::to_string(std::stoi(width) * 2));
+  const std::string wrong_camchain = temp_.File("camchain_2x.yaml");
+  std::ofstream(wrong_camchain) << camchain;
+  const std::string output = temp_.File("known");
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  arguments.insert(arguments.end(),
+                   {"--RigCalibrator.method", "known",
+                    "--RigCalibrator.intrinsics_path", wrong_camchain});
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_FAILURE);
+  std::string messages = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(
+      messages.find("the intrinsics of camera cam0 (" + wrong_camchain +
+                    ") are for " + std::to_string(std::stoi(width) * 2) + "x"),
+      std::string::npos)
+      << messages;
+  EXPECT_NE(messages.find("give intrinsics calibrated at the images' size"),
+            std::string::npos)
+      << messages;
+  EXPECT_FALSE(fs::exists(output));
+
+  std::vector<ImageCorrespondences> images;
+  std::string error;
+  ASSERT_TRUE(
+      ReadCorrespondenceFile(data_ + "/correspondences.txt", &images, &error))
+      << error;
+  images.back().width += 2;
+  const std::string correspondences = temp_.File("resized.txt");
+  ASSERT_TRUE(WriteCorrespondenceFile(correspondences, images, &error))
+      << error;
+  arguments = CalibrateArguments(output);
+  arguments[1] = correspondences;
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_FAILURE);
+  messages = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(messages.find(" have different sizes (" + images.back().image_name +
+                          " is " + std::to_string(images.back().width) + "x"),
+            std::string::npos)
+      << messages;
+  EXPECT_FALSE(fs::exists(output));
+}
+
 // known_ra takes the given intrinsics and the robust rig initialization: it
 // runs, writes the given intrinsics unchanged, and the rig is accurate.
 TEST_F(CommandsTest, KnownRaMethodWithIntrinsicsFile) {

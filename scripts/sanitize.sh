@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Builds rig_calibrator and its whole test suite with AddressSanitizer and
+# UndefinedBehaviorSanitizer into build-sanitize/ (or
+# $RIG_CALIBRATOR_SANITIZE_BUILD_DIR) and runs every test (unit and e2e) there.
+# Any ASan or UBSan report fails the test that triggered it. Extra arguments go
+# to ctest (e.g. -LE e2e for the unit tests only).
+#   RIG_CALIBRATOR_SANITIZE_TARGETS="input_limits_test database_reader_test"
+#   builds (and so runs) only those test executables.
+#
+# Our code is instrumented; COLMAP's, Ceres' and the system's libraries are
+# not, so a bug inside them is out of reach, but every access our code makes
+# to their memory is checked.
+set -euo pipefail
+
+log_tag=sanitize
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+cache="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}"
+jobs="$(nproc 2>/dev/null || echo 2)"
+sanitize_build="${RIG_CALIBRATOR_SANITIZE_BUILD_DIR:-$repo/build-sanitize}"
+start=$SECONDS
+
+bash "$repo/scripts/setup_deps.sh"
+export CCACHE_DIR="${CCACHE_DIR:-$cache/ccache}"
+export CCACHE_BASEDIR="$repo"
+
+# halt_on_error / -fno-sanitize-recover: the first report ends the process
+# with a non-zero status, so ctest marks the test failed. gtest_discover_tests
+# runs the test executables while building, hence the options are exported
+# before the build.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-halt_on_error=1:abort_on_error=0:detect_leaks=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+flags="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+
+run_step "configure ($sanitize_build)" \
+  cmake -S "$repo" -B "$sanitize_build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_PREFIX_PATH="$cache/colmap-3.8" -DCMAKE_CXX_FLAGS="$flags" \
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
+targets=()
+for target in ${RIG_CALIBRATOR_SANITIZE_TARGETS:-}; do
+  targets+=(--target "$target")
+done
+run_step "build (ASan + UBSan)" cmake --build "$sanitize_build" -j"$jobs" \
+  "${targets[@]}"
+run_step "ctest (ASan + UBSan)" \
+  ctest --test-dir "$sanitize_build" --output-on-failure -j"$jobs" "$@"
+print_timings "$start"
+echo "[$log_tag] done: no sanitizer report, every test passed"
