@@ -265,6 +265,12 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
   SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
   FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
   ba_options.num_threads = options.SolverNumThreads();
+  // Map images can all be missing although there is a map (e.g. its cameras
+  // are of models this build cannot project): nothing to adjust then.
+  if (dataset.map_images.empty()) {
+    ba_options.refine_map = false;
+    ba_options.refine_map_intrinsics = false;
+  }
   if (!RefinesIntrinsics(method)) {
     ba_options.refine_focal_length = false;
     ba_options.refine_principal_point = false;

@@ -194,8 +194,8 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
   WriteBytes(prefix + "points3D.bin", HundredBytes(Binary(huge)));
   EXPECT_EQ(MapError(folder),
             prefix +
-                "points3D.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): a point record claims 1 entries, more "
+                "points3D.bin is not a COLMAP binary model file: "
+                "a point record claims 1 entries, more "
                 "than the 41 bytes left can hold");
   // One point whose track claims 10^12 elements.
   WriteBytes(prefix + "points3D.bin",
@@ -203,8 +203,8 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
                           std::string(8 + 24 + 3 + 8, '\0') + Binary(huge)));
   EXPECT_EQ(MapError(folder),
             prefix +
-                "points3D.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): a point's track claims 1000000000000 "
+                "points3D.bin is not a COLMAP binary model file: "
+                "a point's track claims 1000000000000 "
                 "entries, more than the 41 bytes left can hold");
   WriteModel(folder);
 
@@ -214,8 +214,8 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
                           "a.png" + std::string(1, '\0') + Binary(huge)));
   EXPECT_EQ(MapError(folder),
             prefix +
-                "images.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): an image's points2D claims 1000000000000 "
+                "images.bin is not a COLMAP binary model file: "
+                "an image's points2D claims 1000000000000 "
                 "entries, more than the 14 bytes left can hold");
   WriteModel(folder);
 
@@ -226,9 +226,8 @@ TEST(InputLimits, BinaryModelCountsBeyondTheFileFailFast) {
       HundredBytes(Binary(huge) + Binary<uint32_t>(1) + Binary<int32_t>(2)));
   EXPECT_EQ(MapError(folder),
             prefix +
-                "cameras.bin is not a COLMAP binary model file (of "
-                "COLMAP 3.8): camera parameters claims 3 entries, "
-                "more than the 12 bytes left can hold");
+                "cameras.bin is not a COLMAP binary model file: it ends inside "
+                "the parameters of camera 0");
 }
 
 // COLMAP 3.8 keeps the first record of an id and drops the others (and
