@@ -33,6 +33,17 @@ std::string ReadBytes(const std::string& path) {
                      std::istreambuf_iterator<char>());
 }
 
+std::map<std::string, std::string> SnapshotFolder(const std::string& folder) {
+  std::map<std::string, std::string> files;
+  for (boost::filesystem::recursive_directory_iterator it(folder), end;
+       it != end; ++it) {
+    files[it->path().string()] = boost::filesystem::is_directory(it->path())
+                                     ? "/"
+                                     : ReadBytes(it->path().string());
+  }
+  return files;
+}
+
 std::set<std::string> ListFolder(const std::string& path) {
   std::set<std::string> names;
   for (boost::filesystem::directory_iterator it(path), end; it != end; ++it) {

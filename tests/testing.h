@@ -1,6 +1,7 @@
 // Helpers shared by the tests.
 #pragma once
 
+#include <map>
 #include <set>
 #include <string>
 
@@ -29,6 +30,11 @@ std::string ReadBytes(const std::string& path);
 
 // The names of the entries of a folder.
 std::set<std::string> ListFolder(const std::string& path);
+
+// Every file below `folder` (path -> its bytes) and every folder below it
+// (path -> "/"): two snapshots are equal iff nothing was added, removed or
+// changed.
+std::map<std::string, std::string> SnapshotFolder(const std::string& folder);
 
 // The repository's root and the build tree, as configured by CMake.
 std::string SourceDir();

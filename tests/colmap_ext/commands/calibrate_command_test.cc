@@ -34,16 +34,6 @@ void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
-// Every file under `folder` (path -> bytes) and every folder (path -> "/").
-std::map<std::string, std::string> Snapshot(const std::string& folder) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
-    files[entry.path().string()] =
-        entry.is_directory() ? "/" : testing::ReadBytes(entry.path().string());
-  }
-  return files;
-}
-
 using testing::ExecuteSql;
 
 // Features of one image: keypoints on a grid, descriptors from `random`.
@@ -169,9 +159,10 @@ class CalibrateCommandBadInput : public ::testing::Test {
   // messages, no output and unchanged inputs.
   void ExpectFails(const std::vector<std::string>& arguments,
                    const std::vector<std::string>& expected) {
-    const std::map<std::string, std::string> inputs_before = Snapshot(inputs_);
+    const std::map<std::string, std::string> inputs_before =
+        testing::SnapshotFolder(inputs_);
     const std::map<std::string, std::string> temp_before =
-        Snapshot(temp_.path());
+        testing::SnapshotFolder(temp_.path());
     ::testing::internal::CaptureStderr();
     ::testing::internal::CaptureStdout();
     const int exit_code = testing::RunCommand(&RunCalibrate, arguments);
@@ -189,8 +180,8 @@ class CalibrateCommandBadInput : public ::testing::Test {
     EXPECT_FALSE(fs::exists(output_));
     // No temporary output folder and no database side file (-wal, -shm,
     // -journal) left behind, and the inputs are byte for byte the same.
-    EXPECT_EQ(Snapshot(temp_.path()), temp_before);
-    EXPECT_TRUE(Snapshot(inputs_) == inputs_before);
+    EXPECT_EQ(testing::SnapshotFolder(temp_.path()), temp_before);
+    EXPECT_TRUE(testing::SnapshotFolder(inputs_) == inputs_before);
   }
 
   testing::ScopedTempDir temp_;

@@ -47,16 +47,6 @@ std::string DataDir() {
   return testing::SourceDir() + "/tests/data/colmap_4_1_1";
 }
 
-// Every file under `folder` with its bytes.
-std::map<std::string, std::string> Snapshot(const std::string& folder) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
-    files[entry.path().string()] =
-        entry.is_directory() ? "/" : testing::ReadBytes(entry.path().string());
-  }
-  return files;
-}
-
 class Colmap411CalibrationTest : public ::testing::Test {
  protected:
   // Runs calibrate; returns what it printed (and echoes it for the log).
@@ -170,7 +160,8 @@ class Colmap411MapTypeTest : public Colmap411CalibrationTest,
 
 TEST_P(Colmap411MapTypeTest, CalibratesWithoutTouchingTheInputs) {
   const std::string map = DataDir() + "/map/" + GetParam();
-  const std::map<std::string, std::string> inputs_before = Snapshot(DataDir());
+  const std::map<std::string, std::string> inputs_before =
+      testing::SnapshotFolder(DataDir());
   const std::string output = temp_.File("calibration");
   int exit_code = 0;
   const std::string printed = Calibrate(
@@ -181,7 +172,7 @@ TEST_P(Colmap411MapTypeTest, CalibratesWithoutTouchingTheInputs) {
   ASSERT_EQ(exit_code, EXIT_SUCCESS);
   // The database and everything else byte for byte unchanged, no -wal or
   // -shm file next to the database.
-  EXPECT_TRUE(Snapshot(DataDir()) == inputs_before);
+  EXPECT_TRUE(testing::SnapshotFolder(DataDir()) == inputs_before);
   EXPECT_FALSE(fs::exists(DataDir() + "/calib.db-wal"));
   EXPECT_FALSE(fs::exists(DataDir() + "/calib.db-shm"));
 
