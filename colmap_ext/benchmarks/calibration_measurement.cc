@@ -25,6 +25,7 @@ bool MeasureCalibration(const RuntimeBenchmarkOptions& options,
   pipeline_options.num_threads = options.num_threads;
   pipeline_options.seed = static_cast<unsigned int>(options.seed);
   pipeline_options.print_progress = false;
+  pipeline_options.deterministic_solvers = options.deterministic_solvers;
   pipeline_options.final_bundle_adjustment.refine_points =
       options.refine_points;
   if (!rig_options.Check(error)) return false;
@@ -53,8 +54,8 @@ bool MeasureCalibration(const RuntimeBenchmarkOptions& options,
   runtime->error = report.error;
   runtime->final_rms_px = report.final_rms_px;
   for (const StageTiming& timing : report.timings) {
-    runtime->stages.push_back(
-        {timing.stage, timing.seconds, timing.cpu_seconds});
+    runtime->stages.push_back({timing.stage, timing.seconds, timing.cpu_seconds,
+                               timing.num_iterations});
   }
   if (runtime->success) {
     const CalibrationError accuracy =

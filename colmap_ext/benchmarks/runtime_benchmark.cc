@@ -106,20 +106,26 @@ std::vector<std::string> StageNames(
   return names;
 }
 
-// Wall and CPU seconds of a stage in a run (NaN if it did not run); a stage
-// that ran twice (a fallback) counts with its total.
-std::pair<double, double> StageSeconds(const CalibrationRuntime& run,
-                                       const std::string& name) {
+// Wall and CPU seconds and solver iterations of a stage in a run (NaN
+// seconds if it did not run); a stage that ran twice (a fallback) counts
+// with its total.
+struct StageTotals {
   double seconds = 0, cpu_seconds = 0;
+  int num_iterations = 0;
+};
+StageTotals StageSeconds(const CalibrationRuntime& run,
+                         const std::string& name) {
+  StageTotals totals;
   bool found = false;
   for (const StageRuntime& stage : run.stages) {
     if (stage.stage != name) continue;
-    seconds += stage.seconds;
-    cpu_seconds += stage.cpu_seconds;
+    totals.seconds += stage.seconds;
+    totals.cpu_seconds += stage.cpu_seconds;
+    totals.num_iterations += stage.num_iterations;
     found = true;
   }
-  if (!found) return {std::nan(""), std::nan("")};
-  return {seconds, cpu_seconds};
+  if (!found) totals.seconds = totals.cpu_seconds = std::nan("");
+  return totals;
 }
 
 std::set<int> CameraCounts(const std::vector<CalibrationRuntime>& runs) {
@@ -148,7 +154,7 @@ std::string SerializeCalibrationRuntime(const CalibrationRuntime& runtime) {
        << "error " << OneLine(runtime.error) << "\n";
   for (const StageRuntime& stage : runtime.stages) {
     text << "stage " << stage.seconds << " " << stage.cpu_seconds << " "
-         << OneLine(stage.stage) << "\n";
+         << stage.num_iterations << " " << OneLine(stage.stage) << "\n";
   }
   return text.str();
 }
@@ -180,7 +186,8 @@ bool ParseCalibrationRuntime(const std::string& text,
   for (const std::string& line : fields.stages()) {
     std::istringstream stream(line);
     StageRuntime stage;
-    if (!(stream >> stage.seconds >> stage.cpu_seconds)) {
+    if (!(stream >> stage.seconds >> stage.cpu_seconds >>
+          stage.num_iterations)) {
       *error = "malformed stage line: " + line;
       return false;
     }
@@ -250,7 +257,8 @@ std::string CalibrationRuntimeCsv(const std::vector<CalibrationRuntime>& runs) {
   std::ostringstream csv;
   csv << "framesets,cameras,images,correspondences,success";
   for (const std::string& stage : stages) {
-    csv << ",\"" << stage << " wall s\",\"" << stage << " CPU s\"";
+    csv << ",\"" << stage << " wall s\",\"" << stage << " CPU s\",\"" << stage
+        << " iterations\"";
   }
   csv << ",total wall s,total CPU s,peak memory MB,final RMS px,"
          "max rotation error deg,max center error m\n";
@@ -258,9 +266,11 @@ std::string CalibrationRuntimeCsv(const std::vector<CalibrationRuntime>& runs) {
     csv << run.num_framesets << "," << run.num_cameras << "," << run.num_images
         << "," << run.num_correspondences << "," << (run.success ? 1 : 0);
     for (const std::string& stage : stages) {
-      const auto [seconds, cpu_seconds] = StageSeconds(run, stage);
-      csv << "," << (std::isfinite(seconds) ? Fixed(seconds, 3) : "") << ","
-          << (std::isfinite(cpu_seconds) ? Fixed(cpu_seconds, 3) : "");
+      const StageTotals totals = StageSeconds(run, stage);
+      const bool ran = std::isfinite(totals.seconds);
+      csv << "," << (ran ? Fixed(totals.seconds, 3) : "") << ","
+          << (ran ? Fixed(totals.cpu_seconds, 3) : "") << ","
+          << (ran ? std::to_string(totals.num_iterations) : "");
     }
     csv << "," << Fixed(run.seconds, 3) << "," << Fixed(run.cpu_seconds, 3)
         << "," << Fixed(run.peak_memory_mb, 1) << ","
@@ -333,8 +343,13 @@ std::string CalibrationRuntimeMarkdown(
     md << "| " << run.num_framesets << " | " << run.num_cameras << " | "
        << run.num_images << " | " << run.num_correspondences << " |";
     for (const std::string& stage : stages) {
-      const auto [seconds, cpu_seconds] = StageSeconds(run, stage);
-      md << " " << Fixed(seconds, 2) << " (" << Fixed(cpu_seconds, 2) << ") |";
+      const StageTotals totals = StageSeconds(run, stage);
+      md << " " << Fixed(totals.seconds, 2) << " ("
+         << Fixed(totals.cpu_seconds, 2) << ")"
+         << (totals.num_iterations > 0
+                 ? " [" + std::to_string(totals.num_iterations) + "]"
+                 : "")
+         << " |";
     }
     md << " " << Fixed(run.seconds, 2) << " | " << Fixed(run.cpu_seconds, 2)
        << " | " << Fixed(run.peak_memory_mb, 0) << " | ";
@@ -347,7 +362,7 @@ std::string CalibrationRuntimeMarkdown(
     }
   }
   md << "\nStage cells: wall seconds (CPU seconds, user + system over all "
-        "threads).\n";
+        "threads) [solver iterations].\n";
   for (const int num_cameras : CameraCounts(runs)) {
     const double exponent = GrowthExponent(runs, num_cameras);
     if (std::isfinite(exponent)) {

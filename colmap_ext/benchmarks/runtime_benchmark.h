@@ -19,6 +19,7 @@ struct StageRuntime {
   std::string stage;
   double seconds = 0;      // wall
   double cpu_seconds = 0;  // user + system, all threads
+  int num_iterations = 0;  // solver iterations (bundle adjustments)
 };
 
 // One run of the calibration core (CalibrateRig) on a synthetic rig.

@@ -134,8 +134,9 @@ StageTimer::StageTimer(const std::string& name, bool print,
 }
 
 StageTimer::~StageTimer() {
-  report_->timings.push_back(
-      {name_, timer_.ElapsedSeconds(), ProcessCpuSeconds() - cpu_start_});
+  report_->timings.push_back({name_, timer_.ElapsedSeconds(),
+                              ProcessCpuSeconds() - cpu_start_,
+                              num_iterations_});
 }
 
 }  // namespace rig_calibrator

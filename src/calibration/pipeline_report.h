@@ -30,6 +30,9 @@ struct StageTiming {
   // CPU time of the whole process (all threads, user + system) during the
   // stage: unlike wall time, hardly affected by other work on the machine.
   double cpu_seconds = 0;
+  // Solver iterations of the stage's bundle adjustment (Ceres steps over
+  // all its solves); 0 for stages without one.
+  int num_iterations = 0;
 };
 
 struct PipelineReport {
@@ -84,8 +87,13 @@ class StageTimer {
   StageTimer(const std::string& name, bool print, PipelineReport* report);
   ~StageTimer();
 
+  void SetNumIterations(int num_iterations) {
+    num_iterations_ = num_iterations;
+  }
+
  private:
   std::string name_;
+  int num_iterations_ = 0;
   PipelineReport* report_;
   colmap::Timer timer_;
   double cpu_start_;

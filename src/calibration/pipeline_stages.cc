@@ -203,6 +203,7 @@ bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
       report->error = "the radial bundle adjustment failed (see above)";
       return false;
     }
+    stage.SetNumIterations(summary.num_iterations);
     if (options.print_progress) {
       std::cout << "  radial RMS " << summary.initial_rms_px << " -> "
                 << summary.final_rms_px << " px over " << summary.num_residuals
@@ -281,6 +282,7 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
     report->error = "the final bundle adjustment failed (see above)";
     return false;
   }
+  stage.SetNumIterations(summary.num_iterations);
   report->final_rms_px = summary.final_rms_px;
   if (options.print_progress) {
     std::cout << "  RMS " << summary.initial_rms_px << " -> "

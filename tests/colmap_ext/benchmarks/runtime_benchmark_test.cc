@@ -16,8 +16,9 @@ CalibrationRuntime MakeRun(int num_framesets, int num_cameras,
   run.num_images = num_framesets * num_cameras;
   run.num_correspondences = 300L * run.num_images;
   run.generation_seconds = 0.25;
-  run.stages = {{"Single-image localization", 0.5, 0.9},
-                {"Final bundle adjustment", cpu_seconds / 3, cpu_seconds / 2}};
+  run.stages = {
+      {"Single-image localization", 0.5, 0.9, 0},
+      {"Final bundle adjustment", cpu_seconds / 3, cpu_seconds / 2, 17}};
   run.seconds = cpu_seconds / 1.5;
   run.cpu_seconds = cpu_seconds;
   run.peak_memory_mb = 123.4;
@@ -65,6 +66,7 @@ TEST(RuntimeBenchmark, CalibrationRuntimeRoundTrips) {
   EXPECT_EQ(parsed.stages[1].stage, "Final bundle adjustment");
   EXPECT_NEAR(parsed.stages[1].seconds, 41.5 / 3, 1e-8);
   EXPECT_NEAR(parsed.stages[1].cpu_seconds, 41.5 / 2, 1e-8);
+  EXPECT_EQ(parsed.stages[1].num_iterations, 17);
 
   EXPECT_FALSE(ParseCalibrationRuntime("something else\n", &parsed, &error));
   EXPECT_NE(error.find("header"), std::string::npos);
@@ -116,11 +118,11 @@ TEST(RuntimeBenchmark, LocalizationRuntimeRoundTrips) {
       SerializeCalibrationRuntime(MakeRun(10, 5, 1)), &parsed, &error));
 }
 
-TEST(RuntimeBenchmark, CsvHasOneColumnPairPerStageAndOneRowPerRun) {
+TEST(RuntimeBenchmark, CsvHasThreeColumnsPerStageAndOneRowPerRun) {
   std::vector<CalibrationRuntime> runs = {MakeRun(10, 5, 1.0),
                                           MakeRun(50, 5, 5.0)};
   // A fallback run has an extra stage: a column for it, empty elsewhere.
-  runs[1].stages.push_back({"Rig initialization", 0.125, 0.25});
+  runs[1].stages.push_back({"Rig initialization", 0.125, 0.25, 0});
   const std::vector<std::string> lines = Lines(CalibrationRuntimeCsv(runs));
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0].rfind("framesets,cameras,images,correspondences,success,"
@@ -128,14 +130,17 @@ TEST(RuntimeBenchmark, CsvHasOneColumnPairPerStageAndOneRowPerRun) {
                            0),
             0u);
   EXPECT_NE(lines[0].find("\"Rig initialization CPU s\""), std::string::npos);
+  EXPECT_NE(lines[0].find("\"Final bundle adjustment iterations\""),
+            std::string::npos);
   const auto count_commas = [](const std::string& line) {
     return std::count(line.begin(), line.end(), ',');
   };
   EXPECT_EQ(count_commas(lines[1]), count_commas(lines[0]));
   EXPECT_EQ(count_commas(lines[2]), count_commas(lines[0]));
-  EXPECT_EQ(lines[1].rfind("10,5,50,15000,1,0.500,0.900,", 0), 0u);
-  EXPECT_NE(lines[1].find(",,,"), std::string::npos);  // no Rig init.
-  EXPECT_NE(lines[2].find(",0.125,0.250,"), std::string::npos);
+  EXPECT_EQ(lines[1].rfind("10,5,50,15000,1,0.500,0.900,0,0.333,0.500,17,", 0),
+            0u);
+  EXPECT_NE(lines[1].find(",,,,"), std::string::npos);  // no Rig init.
+  EXPECT_NE(lines[2].find(",0.125,0.250,0,"), std::string::npos);
 }
 
 TEST(RuntimeBenchmark, LocalizationTablesGiveCpuSecondsPerImage) {
