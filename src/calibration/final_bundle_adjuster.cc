@@ -48,14 +48,35 @@ bool CheckInput(const FinalBundleAdjustmentOptions& options,
   return true;
 }
 
+// Stop a solve when an iteration lowers the cost by less than this share of
+// it (Ceres' default 1e-6). With refined map points the last iterations only
+// polish tens of thousands of points: 500 framesets x 10 cameras, final BA
+// 58 s -> 40 s, 200 x 10: 24 -> 12 s, with the same errors against the truth
+// (and the same on the rendered demo); exact data still converge to 1e-8.
+constexpr double kFunctionTolerance = 1e-5;
+// A solve whose only use is to tell the outliers from the inliers stops
+// earlier: the residuals that decide the pruning (thresholds of 2 px or
+// more) no longer move once the cost changes by 1e-3 per iteration, and the
+// next solve starts from its result. Issue 14's 500 x 10 scenario: the first
+// solve takes 4 iterations instead of 10, with the same errors against the
+// truth.
+constexpr double kPruningFunctionTolerance = 1e-3;
+
 // The first solve, then prune-and-resolve rounds until a round prunes
-// nothing or num_pruning_rounds are done. Fills the counts of `result`.
+// nothing or num_pruning_rounds are done. A solve followed by a pruning
+// round stops at kPruningFunctionTolerance; if that round prunes nothing,
+// one more solve converges to kFunctionTolerance. Fills the counts of
+// `result`.
 bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
                       RigAdjustment* adjustment,
                       FinalBundleAdjustmentSummary* result) {
   ceres::Solver::Summary ceres_summary;
+  bool nothing_pruned = false;
   for (int round = 0;; ++round) {
-    if (!adjustment->Solve(&ceres_summary)) {
+    const bool last = round >= options.num_pruning_rounds;
+    if (!adjustment->Solve(last || nothing_pruned ? kFunctionTolerance
+                                                  : kPruningFunctionTolerance,
+                           &ceres_summary)) {
       return false;
     }
     result->num_residuals = static_cast<int>(adjustment->NumObservations());
@@ -64,16 +85,15 @@ bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
     result->num_iterations += ceres_summary.num_successful_steps +
                               ceres_summary.num_unsuccessful_steps;
     result->ceres_report = ceres_summary.BriefReport();
-    if (round == options.num_pruning_rounds) {
+    if (last || nothing_pruned) {
       return true;
     }
     const size_t num_pruned =
         adjustment->RejectOutliers(/*prune_residuals=*/true);
     VLOG(1) << "Final bundle adjustment: pruned " << num_pruned
             << " outlier observations";
-    if (num_pruned == 0) {
-      return true;
-    }
+    // Nothing pruned: the next solve is the last, to full convergence.
+    nothing_pruned = num_pruned == 0;
     if (adjustment->NumObservations() == 0) {
       LOG(ERROR) << "Final bundle adjustment: every observation was pruned";
       return false;

@@ -5,6 +5,7 @@
 #include <colmap/util/threading.h>
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -240,9 +241,11 @@ std::string CheckInput(const RigDataset& dataset,
 }
 
 // Inlier correspondences of the images of calibrated cameras in posed
-// framesets.
+// framesets; per image at most max_per_image (0: all), the k-th of m taken
+// at inlier floor(k * n / m) of n.
 std::vector<Observation> InlierObservations(const RigDataset& dataset,
-                                            const RigCalibration& calibration) {
+                                            const RigCalibration& calibration,
+                                            int max_per_image) {
   std::vector<Observation> observations;
   for (size_t k = 0; k < dataset.images.size(); ++k) {
     const RigImage& image = dataset.images[k];
@@ -251,13 +254,19 @@ std::vector<Observation> InlierObservations(const RigDataset& dataset,
         !calibration.rig_from_world[image.frameset_index]) {
       continue;
     }
+    std::vector<int> inliers;
     for (size_t c = 0; c < mask.size(); ++c) {
-      if (mask[c]) {
-        observations.push_back({static_cast<int>(k), image.camera_index,
-                                image.frameset_index,
-                                image.correspondences[c].point2D,
-                                image.correspondences[c].point3D});
-      }
+      if (mask[c]) inliers.push_back(static_cast<int>(c));
+    }
+    const size_t n = inliers.size();
+    const size_t m =
+        max_per_image > 0 ? std::min(n, static_cast<size_t>(max_per_image)) : n;
+    for (size_t i = 0; i < m; ++i) {
+      const Correspondence& correspondence =
+          image.correspondences[inliers[i * n / m]];
+      observations.push_back({static_cast<int>(k), image.camera_index,
+                              image.frameset_index, correspondence.point2D,
+                              correspondence.point3D});
     }
   }
   return observations;
@@ -354,15 +363,18 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   const std::string error = CheckInput(dataset, *calibration);
   if (!error.empty()) return Fail(error, summary);
   if (!(options.loss_scale_px > 0) || options.max_num_iterations < 0 ||
-      !(options.max_radial_error_px >= 0)) {
+      !(options.max_radial_error_px >= 0) ||
+      options.max_correspondences_per_image < 0) {
     return Fail(
-        "loss_scale_px must be positive, max_num_iterations and "
-        "max_radial_error_px non-negative",
+        "loss_scale_px must be positive, max_num_iterations, "
+        "max_radial_error_px and max_correspondences_per_image non-negative",
         summary);
   }
   const int reference = dataset.reference_camera;
   std::vector<Observation> observations = KeepDeterminedFramesets(
-      InlierObservations(dataset, *calibration), *calibration);
+      InlierObservations(dataset, *calibration,
+                         options.max_correspondences_per_image),
+      *calibration);
   const std::string no_reference_message =
       "the reference camera " + dataset.cameras[reference].name +
       " has no inlier correspondences in framesets with a determined rig pose";

@@ -29,6 +29,13 @@ struct RadialBundleAdjustmentOptions {
   // with one another and add up along the weakly constrained
   // principal point / pan-tilt direction. 0: keep all.
   double max_radial_error_px = 8.0;
+  // The adjustment is only the initialization of the camera upgrade and the
+  // final bundle adjustment, and a rig pose has 6 unknowns, a camera 7: at
+  // most this many of an image's correspondences take part (evenly spaced
+  // over the image's inliers, so the selection is fixed for given data).
+  // Issue 14's 500 framesets x 10 cameras: radial BA 3x faster with the
+  // same final errors against the truth. 0: all.
+  int max_correspondences_per_image = 100;
   int num_threads = -1;
   bool print_progress = false;  // Ceres per-iteration progress on stdout
 };

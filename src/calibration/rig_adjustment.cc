@@ -1,5 +1,6 @@
 #include "src/calibration/rig_adjustment.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rig_calibrator {
@@ -162,29 +163,40 @@ double RigAdjustment::RmsError() const {
   return observations_.empty() ? 0 : std::sqrt(sum / observations_.size());
 }
 
+Eigen::Vector3d* RigAdjustment::RefinedPoint(int64_t point3D_id) {
+  const auto it = refined_point_index_.find(point3D_id);
+  return it != refined_point_index_.end() ? &refined_points_[it->second]
+                                          : nullptr;
+}
+
+const Eigen::Vector3d* RigAdjustment::RefinedPoint(int64_t point3D_id) const {
+  const auto it = refined_point_index_.find(point3D_id);
+  return it != refined_point_index_.end() ? &refined_points_[it->second]
+                                          : nullptr;
+}
+
 const Eigen::Vector3d& RigAdjustment::PointOf(int64_t point3D_id) const {
-  const auto it = refined_points_.find(point3D_id);
-  return it != refined_points_.end() ? it->second : map_points_.at(point3D_id);
+  const Eigen::Vector3d* refined = RefinedPoint(point3D_id);
+  return refined != nullptr ? *refined : map_points_.at(point3D_id);
 }
 
 bool RigAdjustment::IsPointRefined(int64_t point3D_id) const {
-  return point3D_id >= 0 && refined_points_.count(point3D_id) > 0;
+  return point3D_id >= 0 && refined_point_index_.count(point3D_id) > 0;
 }
 
 const Eigen::Vector3d& RigAdjustment::PointOf(
     const Correspondence& correspondence) const {
   if (correspondence.point3D_id >= 0) {
-    const auto it = refined_points_.find(correspondence.point3D_id);
-    if (it != refined_points_.end()) {
-      return it->second;
+    if (const Eigen::Vector3d* refined =
+            RefinedPoint(correspondence.point3D_id)) {
+      return *refined;
     }
   }
   return correspondence.point3D;
 }
 
 bool RigAdjustment::IsPointRefined(const Correspondence& correspondence) const {
-  return correspondence.point3D_id >= 0 &&
-         refined_points_.count(correspondence.point3D_id) > 0;
+  return IsPointRefined(correspondence.point3D_id);
 }
 
 void RigAdjustment::SelectRefinedPoints() {
@@ -212,15 +224,23 @@ void RigAdjustment::SelectRefinedPoints() {
       }
     }
   }
-  std::unordered_map<int64_t, Eigen::Vector3d> refined_points;
+  std::vector<int64_t> refined_ids;
   for (const auto& [point3D_id, counts] : num_observations) {
-    if (counts.first + counts.second >= 2) {
-      const auto it = refined_points_.find(point3D_id);
-      refined_points[point3D_id] =
-          it != refined_points_.end() ? it->second : map_points_.at(point3D_id);
-    }
+    if (counts.first + counts.second >= 2) refined_ids.push_back(point3D_id);
+  }
+  std::sort(refined_ids.begin(), refined_ids.end());
+  std::vector<Eigen::Vector3d> refined_points;
+  refined_points.reserve(refined_ids.size());
+  std::unordered_map<int64_t, size_t> refined_point_index;
+  refined_point_index.reserve(refined_ids.size());
+  for (const int64_t point3D_id : refined_ids) {
+    const Eigen::Vector3d* refined = RefinedPoint(point3D_id);
+    refined_point_index[point3D_id] = refined_points.size();
+    refined_points.push_back(refined != nullptr ? *refined
+                                                : map_points_.at(point3D_id));
   }
   refined_points_ = std::move(refined_points);
+  refined_point_index_ = std::move(refined_point_index);
 }
 
 void RigAdjustment::WriteTo(RigCalibration* calibration) const {
@@ -256,8 +276,8 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
     }
   }
   calibration->refined_points3D.clear();
-  for (const auto& [point3D_id, point] : refined_points_) {
-    calibration->refined_points3D[point3D_id] = point;
+  for (const auto& [point3D_id, slot] : refined_point_index_) {
+    calibration->refined_points3D[point3D_id] = refined_points_[slot];
   }
   calibration->map_cameras.clear();
   calibration->map_cam_from_world.clear();

@@ -63,9 +63,10 @@ class RigAdjustment {
   // output model). Returns how many were rejected.
   size_t RejectMapOutliers();
 
-  // Builds the problem over the current observations and solves it. False
-  // (logged) when Ceres finds no usable solution.
-  bool Solve(ceres::Solver::Summary* summary);
+  // Builds the problem over the current observations and solves it, until
+  // an iteration lowers the cost by less than function_tolerance of it.
+  // False (logged) when Ceres finds no usable solution.
+  bool Solve(double function_tolerance, ceres::Solver::Summary* summary);
 
   // Writes the estimate and the per-image results (see AdjustRig).
   void WriteTo(RigCalibration* calibration) const;
@@ -119,7 +120,8 @@ class RigAdjustment {
 
   void AddResidualBlocks(ceres::Problem* problem);
   void SetUpParameterBlocks(ceres::Problem* problem);
-  ceres::Solver::Options SolverOptions(const ceres::Problem& problem);
+  ceres::Solver::Options SolverOptions(const ceres::Problem& problem,
+                                       double function_tolerance);
 
   const FinalBundleAdjustmentOptions& options_;
   const RigDataset& dataset_;
@@ -139,9 +141,16 @@ class RigAdjustment {
   // cam_from_rig of a map image seen as a one-camera rig (the identity,
   // constant), so that its residuals are RigReprojectionCosts too.
   PoseParams identity_pose_ = {1, 0, 0, 0, 0, 0, 0};
-  // By point3D_id: the map positions and the points being refined.
+  // By point3D_id: the map positions. The points being refined are one
+  // vector in increasing point3D_id order (refined_point_index_: id -> slot),
+  // so that their parameter blocks lie in a fixed address order, which is
+  // the order Ceres eliminates them in (SolverOptions).
   std::unordered_map<int64_t, Eigen::Vector3d> map_points_;
-  std::unordered_map<int64_t, Eigen::Vector3d> refined_points_;
+  std::vector<Eigen::Vector3d> refined_points_;
+  std::unordered_map<int64_t, size_t> refined_point_index_;
+  // The refined point of point3D_id, or null.
+  Eigen::Vector3d* RefinedPoint(int64_t point3D_id);
+  const Eigen::Vector3d* RefinedPoint(int64_t point3D_id) const;
   bool has_fixed_points_ = false;
   // Ceres does not own these; they outlive every problem built here.
   std::unique_ptr<ceres::LossFunction> loss_;

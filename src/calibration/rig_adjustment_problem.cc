@@ -13,7 +13,8 @@
 
 namespace rig_calibrator {
 
-bool RigAdjustment::Solve(ceres::Solver::Summary* summary) {
+bool RigAdjustment::Solve(double function_tolerance,
+                          ceres::Solver::Summary* summary) {
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -23,7 +24,8 @@ bool RigAdjustment::Solve(ceres::Solver::Summary* summary) {
   }
   AddResidualBlocks(&problem);
   SetUpParameterBlocks(&problem);
-  const ceres::Solver::Options solver_options = SolverOptions(problem);
+  const ceres::Solver::Options solver_options =
+      SolverOptions(problem, function_tolerance);
   VLOG(1) << "Final bundle adjustment: " << problem.NumResidualBlocks()
           << " observations (" << problem.NumResiduals() << " residuals), "
           << problem.NumParameterBlocks() << " parameter blocks";
@@ -50,7 +52,7 @@ void RigAdjustment::AddResidualBlocks(ceres::Problem* problem) {
           CreateRigReprojectionCost(camera.ModelId(), correspondence.point2D,
                                     nullptr),
           loss_.get(), rig_from_world, cam_from_rig, camera.ParamsData(),
-          refined_points_.at(correspondence.point3D_id).data());
+          RefinedPoint(correspondence.point3D_id)->data());
     } else {
       has_fixed_points_ = true;
       problem->AddResidualBlock(
@@ -68,7 +70,7 @@ void RigAdjustment::AddResidualBlocks(ceres::Problem* problem) {
                                   nullptr),
         loss_.get(), map_cam_from_world_[observation.image].data(),
         identity_pose_.data(), camera.ParamsData(),
-        refined_points_.at(map_observation.point3D_id).data());
+        RefinedPoint(map_observation.point3D_id)->data());
     has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
   }
 }
@@ -140,7 +142,7 @@ void RigAdjustment::SetUpParameterBlocks(ceres::Problem* problem) {
 }
 
 ceres::Solver::Options RigAdjustment::SolverOptions(
-    const ceres::Problem& problem) {
+    const ceres::Problem& problem, double function_tolerance) {
   ceres::Solver::Options solver_options;
   solver_options.max_num_iterations = options_.max_num_iterations;
   solver_options.num_threads =
@@ -154,12 +156,7 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
   // (relative to the whole parameter vector, dominated by the focal lengths)
   // would stop a few digits short.
   solver_options.parameter_tolerance = 1e-12;
-  // Stop when an iteration lowers the cost by less than 1e-5 of it (Ceres'
-  // default 1e-6). With refined map points the last iterations only polish
-  // tens of thousands of points: 500 framesets x 10 cameras, final BA 58 s ->
-  // 40 s, 200 x 10: 24 -> 12 s, with the same errors against the truth (and
-  // the same on the rendered demo); exact data still converge to 1e-8.
-  solver_options.function_tolerance = 1e-5;
+  solver_options.function_tolerance = function_tolerance;
 
   // Schur elimination group: the variable points when refined (each is seen
   // by several framesets, so the rig poses cannot share the group: the group
@@ -167,18 +164,47 @@ ceres::Solver::Options RigAdjustment::SolverOptions(
   // through the shared camera blocks, leaving a tiny dense reduced system).
   //
   // Ceres lists the blocks of one ordering group by address (a
-  // std::set<double*>), and the points (hash-map nodes) and the camera
-  // parameters (a heap vector per camera) lie where the heap's history put
-  // them: the output folder's name changed the result at 1e-15. So no group
-  // here holds blocks at unrelated addresses. The points are left to Ceres,
-  // which, given no ordering, takes the independent set of the blocks in the
-  // order they were added to the problem, lowest degree first
-  // (ComputeStableSchurOrdering): the points, as above.
-  bool eliminate_points = false;
-  for (auto& [point3D_id, point] : refined_points_) {
-    eliminate_points |= problem.HasParameterBlock(point.data());
+  // std::set<double*>), so no group here holds blocks at unrelated addresses
+  // (the camera parameters are a heap vector per camera): before, the output
+  // folder's name changed the result at 1e-15. The points are one vector in
+  // point3D_id order, the rig poses and the map poses one vector each in
+  // their order; every camera block is a group of its own, in camera order.
+  // Giving Ceres the ordering also spares it the independent-set search over
+  // the whole Hessian graph (a hash set per parameter block), a sizeable part
+  // of each solve's preprocessing with ~10^5 points.
+  std::vector<double*> points;
+  for (Eigen::Vector3d& point : refined_points_) {
+    if (problem.HasParameterBlock(point.data())) points.push_back(point.data());
   }
-  if (eliminate_points) {
+  if (!points.empty()) {
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (double* block : points) ordering->AddElementToGroup(block, 0);
+    int group = 1;
+    const auto add_group = [&](const std::vector<double*>& blocks) {
+      bool added = false;
+      for (double* block : blocks) {
+        if (problem.HasParameterBlock(block)) {
+          ordering->AddElementToGroup(block, group);
+          added = true;
+        }
+      }
+      group += added ? 1 : 0;
+    };
+    std::vector<double*> poses;
+    for (PoseParams& pose : rig_from_world_) poses.push_back(pose.data());
+    add_group(poses);
+    poses.clear();
+    for (PoseParams& pose : map_cam_from_world_) poses.push_back(pose.data());
+    add_group(poses);
+    add_group({identity_pose_.data()});
+    for (size_t camera = 0; camera < cameras_.size(); ++camera) {
+      add_group({cam_from_rig_[camera].data()});
+      add_group({cameras_[camera].ParamsData()});
+    }
+    for (colmap::Camera& camera : map_cameras_) {
+      add_group({camera.ParamsData()});
+    }
+    solver_options.linear_solver_ordering = ordering;
     solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
     return solver_options;
   }
