@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Runtime benchmark: time and peak memory of the calibration core on
 # synthetic rigs (10-500 framesets x 5 and 10 cameras, ~300 correspondences
-# per image) and of the localization against a 300-image map
-# (`rig_calibrator benchmark_runtime`), and optionally the end-to-end time of
-# the rendered demo (scripts/demo.sh) split into COLMAP's steps and ours.
+# per image, map points with 5 mm error) and of the localization against a
+# 300-image map (`rig_calibrator benchmark_runtime`), optionally before and
+# after (another build's runs of the same data, in the same run), and
+# optionally the end-to-end time of the rendered demo (scripts/demo.sh)
+# split into COLMAP's steps and ours.
 #
 # Usage: scripts/benchmark_runtime.sh RESULTS_DIR [benchmark_runtime options...]
 #   RESULTS_DIR  created if needed; gets runtime.md, runtime_calibration.csv,
 #                runtime_calibration.svg, runtime_localization.csv,
+#                with a baseline runtime_calibration_before.csv,
 #                runtime_log.txt and, with the demo, runtime_demo.md and
 #                runtime_demo_log.txt (other files are left alone)
 #   options      passed to `rig_calibrator benchmark_runtime`, e.g.
@@ -16,8 +19,15 @@
 #   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator (default: build/)
 #   RUNTIME_DEMO=1            also time the rendered demo (about 3-4 minutes on
 #                             2 idle cores; DEMO_* variables apply)
-#   BENCHMARK_QUICK=1         without options: a smoke run (10 and 50
-#                             framesets, fewer localized images)
+#   RUNTIME_BASELINE=EXE      another rig_calibrator build (e.g. of the
+#                             previous commit): every calibration run is made
+#                             with it first, then with this build, and
+#                             runtime.md gets the before/after table
+#   BENCHMARK_QUICK=1         without options: a smoke run (10 and 20
+#                             framesets x 5 cameras, a 30-image map, 4
+#                             localized images, this build as its own
+#                             baseline; ~20-40 s), which ctest runs
+#                             (benchmark_runtime_quick) so that it cannot rot
 set -euo pipefail
 
 log_tag=benchmark_runtime
@@ -34,11 +44,16 @@ results="$(cd "$results" && pwd)"
 
 options=("$@")
 if [[ "${BENCHMARK_QUICK:-0}" == 1 && $# -eq 0 ]]; then
-  options=(--framesets 10,50 --rig_features 2000 --rig_images 10
-           --retrieval_images 2)
+  options=(--framesets 10,20 --cameras 5 --map_images 30 --rig_features 1000
+           --rig_images 4 --retrieval_images 1)
+  RUNTIME_BASELINE="${RUNTIME_BASELINE:-$rig_calibrator}"
+fi
+if [[ -n "${RUNTIME_BASELINE:-}" ]]; then
+  [[ -x "$RUNTIME_BASELINE" ]] || die "RUNTIME_BASELINE=$RUNTIME_BASELINE is not an executable rig_calibrator"
+  options+=(--baseline_executable "$RUNTIME_BASELINE")
 fi
 
-echo "[benchmark_runtime] $(uptime)"
+echo "[benchmark_runtime] $(nproc) cores, $(uptime)"
 status=0
 "$rig_calibrator" benchmark_runtime --output_path "$results" "${options[@]}" 2>&1 |
   tee "$results/runtime_log.txt" || status=${PIPESTATUS[0]}

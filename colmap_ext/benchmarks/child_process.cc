@@ -31,7 +31,8 @@ double ProcessCpuSeconds() {
 }
 
 ChildOutcome RunChildProcess(const std::vector<std::string>& arguments,
-                             const std::string& result_path) {
+                             const std::string& result_path,
+                             const std::string& executable) {
   ChildOutcome outcome;
   std::vector<char*> child_argv;
   for (const std::string& argument : arguments) {
@@ -45,8 +46,8 @@ ChildOutcome RunChildProcess(const std::vector<std::string>& arguments,
     return outcome;
   }
   if (pid == 0) {
-    execv("/proc/self/exe", child_argv.data());
-    std::perror("execv /proc/self/exe");
+    execv(executable.c_str(), child_argv.data());
+    std::perror(("execv " + executable).c_str());
     _exit(127);
   }
   int status = 0;

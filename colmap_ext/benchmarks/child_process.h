@@ -17,10 +17,12 @@ struct ChildOutcome {
   std::string error;
 };
 
-// Runs this executable (/proc/self/exe) with `arguments` (argv, argv[0]
-// first), waits for it and reads the file it wrote to `result_path`.
+// Runs `executable` (by default this one, /proc/self/exe) with `arguments`
+// (argv, argv[0] first), waits for it and reads the file it wrote to
+// `result_path`.
 ChildOutcome RunChildProcess(const std::vector<std::string>& arguments,
-                             const std::string& result_path);
+                             const std::string& result_path,
+                             const std::string& executable = "/proc/self/exe");
 
 // "N cores online; load average a, b, c (1, 5, 15 min)": what else ran on
 // the machine.

@@ -399,6 +399,72 @@ std::string LocalizationRuntimeMarkdown(
   return md.str();
 }
 
+namespace {
+
+std::string StageCell(const StageTotals& totals) {
+  if (!std::isfinite(totals.seconds)) return "-";
+  return Fixed(totals.seconds, 2) + " (" + Fixed(totals.cpu_seconds, 2) + ")" +
+         (totals.num_iterations > 0
+              ? " [" + std::to_string(totals.num_iterations) + "]"
+              : "");
+}
+
+std::string Ratio(double before, double after) {
+  return after > 0 && std::isfinite(before) ? Fixed(before / after, 2) : "-";
+}
+
+// Relative change of an error, in percent.
+std::string Change(double before, double after) {
+  return before > 0 ? Fixed(100 * (after - before) / before, 1) + " %" : "-";
+}
+
+}  // namespace
+
+std::string CalibrationBeforeAfterMarkdown(
+    const std::vector<CalibrationRuntime>& before,
+    const std::vector<CalibrationRuntime>& after) {
+  std::ostringstream md;
+  for (size_t k = 0; k < before.size() && k < after.size(); ++k) {
+    const CalibrationRuntime& b = before[k];
+    const CalibrationRuntime& a = after[k];
+    md << "### " << a.num_framesets << " framesets x " << a.num_cameras
+       << " cameras (" << a.num_images << " images, " << a.num_correspondences
+       << " correspondences)\n\n"
+       << "| stage | before: wall s (CPU s) [iterations] | after | wall "
+          "before/after | CPU before/after |\n|---|---|---|---|---|\n";
+    for (const std::string& stage : StageNames({b, a})) {
+      const StageTotals tb = StageSeconds(b, stage);
+      const StageTotals ta = StageSeconds(a, stage);
+      md << "| " << stage << " | " << StageCell(tb) << " | " << StageCell(ta)
+         << " | " << Ratio(tb.seconds, ta.seconds) << " | "
+         << Ratio(tb.cpu_seconds, ta.cpu_seconds) << " |\n";
+    }
+    md << "| **total** | " << Fixed(b.seconds, 2) << " ("
+       << Fixed(b.cpu_seconds, 2) << ") | " << Fixed(a.seconds, 2) << " ("
+       << Fixed(a.cpu_seconds, 2) << ") | " << Ratio(b.seconds, a.seconds)
+       << " | " << Ratio(b.cpu_seconds, a.cpu_seconds) << " |\n"
+       << "| peak memory MB | " << Fixed(b.peak_memory_mb, 0) << " | "
+       << Fixed(a.peak_memory_mb, 0) << " | "
+       << Ratio(b.peak_memory_mb, a.peak_memory_mb) << " | |\n\n"
+       << "| against the truth | before | after | change |\n"
+       << "|---|---|---|---|\n"
+       << "| success | " << (b.success ? "yes" : "no: " + b.error) << " | "
+       << (a.success ? "yes" : "no: " + a.error) << " | |\n"
+       << "| final RMS px | " << Fixed(b.final_rms_px, 4) << " | "
+       << Fixed(a.final_rms_px, 4) << " | "
+       << Change(b.final_rms_px, a.final_rms_px) << " |\n"
+       << "| worst camera rotation error deg | "
+       << Fixed(b.max_rotation_error_deg, 4) << " | "
+       << Fixed(a.max_rotation_error_deg, 4) << " | "
+       << Change(b.max_rotation_error_deg, a.max_rotation_error_deg) << " |\n"
+       << "| worst camera center error mm | "
+       << Fixed(1000 * b.max_center_error_m, 3) << " | "
+       << Fixed(1000 * a.max_center_error_m, 3) << " | "
+       << Change(b.max_center_error_m, a.max_center_error_m) << " |\n\n";
+  }
+  return md.str();
+}
+
 std::string CalibrationRuntimeSvg(const std::vector<CalibrationRuntime>& runs) {
   std::vector<PlotSeries> series;
   double y_max = 0;

@@ -98,6 +98,14 @@ std::string CalibrationRuntimeMarkdown(
 std::string LocalizationRuntimeMarkdown(
     const std::vector<LocalizationRuntime>& runs);
 
+// Per pair of runs of the same configuration (before[k], after[k]): a table
+// with a row per stage (wall s (CPU s) [iterations] of each, and the ratio
+// before / after of wall and of CPU), the totals, the peak memory and the
+// errors against the truth, with their relative change.
+std::string CalibrationBeforeAfterMarkdown(
+    const std::vector<CalibrationRuntime>& before,
+    const std::vector<CalibrationRuntime>& after);
+
 // Line plot: total wall and CPU seconds of CalibrateRig against framesets,
 // one pair of series per camera count (linear axes, so linear growth shows
 // as a straight line).

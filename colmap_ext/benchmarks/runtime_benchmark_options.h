@@ -48,6 +48,11 @@ struct RuntimeBenchmarkOptions {
   }();
   int num_threads = -1;
   int seed = 0;
+  // Another build of rig_calibrator (e.g. of an earlier commit): every
+  // calibration run is made with it first, then with this one, on the same
+  // data, and runtime.md gets a before/after table. It gets this run's
+  // options but this one, so it must know them all.
+  std::string baseline_executable;
   bool calibration = true;
   bool localization = true;
   int map_images = 300;

@@ -1,5 +1,7 @@
 #include "colmap_ext/benchmarks/runtime_benchmark_runner.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <boost/filesystem.hpp>
 #include <cstdlib>
@@ -103,9 +105,11 @@ bool MakeWorkFolder(std::string* work_dir, std::string* error) {
   return true;
 }
 
-// Runs the child of `request` and returns its outcome.
+// Runs the child of `request` (with `executable`, by default this one) and
+// returns its outcome.
 ChildOutcome RunChild(const std::vector<std::string>& base_arguments,
-                      const ChildRequest& request) {
+                      const ChildRequest& request,
+                      const std::string& executable = "/proc/self/exe") {
   std::vector<std::string> arguments = base_arguments;
   arguments.insert(arguments.end(), {"--child", request.child, "--child_result",
                                      request.result_path});
@@ -120,7 +124,42 @@ ChildOutcome RunChild(const std::vector<std::string>& base_arguments,
                       "--child_num_checks", std::to_string(request.num_checks),
                       "--child_work_dir", request.work_dir});
   }
-  return RunChildProcess(arguments, request.result_path);
+  return RunChildProcess(arguments, request.result_path, executable);
+}
+
+// The parent's arguments without --baseline_executable, for the baseline's
+// children (an older build does not know the option).
+std::vector<std::string> BaselineArguments(
+    const std::vector<std::string>& base_arguments,
+    const std::string& baseline_executable) {
+  std::vector<std::string> arguments = {baseline_executable};
+  for (size_t i = 1; i < base_arguments.size(); ++i) {
+    const std::string& argument = base_arguments[i];
+    if (argument == "--baseline_executable") {
+      ++i;  // and its value
+    } else if (argument.rfind("--baseline_executable=", 0) != 0) {
+      arguments.push_back(argument);
+    }
+  }
+  return arguments;
+}
+
+// One calibration child run of `executable`; a failure is a result.
+CalibrationRuntime MeasureCalibrationRun(
+    const std::vector<std::string>& arguments, const ChildRequest& request,
+    const std::string& executable) {
+  const ChildOutcome outcome = RunChild(arguments, request, executable);
+  CalibrationRuntime runtime;
+  std::string error = outcome.error;
+  if (!outcome.ok ||
+      !ParseCalibrationRuntime(outcome.result_text, &runtime, &error)) {
+    runtime = CalibrationRuntime();
+    runtime.num_framesets = request.framesets;
+    runtime.num_cameras = request.cameras;
+    runtime.error = error;
+  }
+  runtime.peak_memory_mb = outcome.peak_memory_mb;
+  return runtime;
 }
 
 void PrintCalibrationRun(const CalibrationRuntime& runtime) {
@@ -138,13 +177,16 @@ void PrintCalibrationRun(const CalibrationRuntime& runtime) {
 }
 
 // Every frameset count x camera count; *all_ok is cleared by a failed run.
+// With a baseline executable each configuration runs with it first, into
+// *before_runs.
 std::vector<CalibrationRuntime> RunCalibrations(
     const RuntimeBenchmarkOptions& options, const RunLists& lists,
     const std::vector<std::string>& base_arguments, const std::string& work_dir,
-    bool* all_ok) {
+    std::vector<CalibrationRuntime>* before_runs, bool* all_ok) {
   std::cout << "Calibration core (" << options.method << ", "
             << options.data.points_per_image
             << " correspondences per image):" << std::endl;
+  const bool with_baseline = !options.baseline_executable.empty();
   std::vector<CalibrationRuntime> runs;
   for (const int num_cameras : lists.cameras) {
     for (const int num_framesets : lists.framesets) {
@@ -155,17 +197,19 @@ std::vector<CalibrationRuntime> RunCalibrations(
       request.result_path = work_dir + "/calibration_" +
                             std::to_string(num_framesets) + "x" +
                             std::to_string(num_cameras) + ".txt";
-      const ChildOutcome outcome = RunChild(base_arguments, request);
-      CalibrationRuntime runtime;
-      std::string error = outcome.error;
-      if (!outcome.ok ||
-          !ParseCalibrationRuntime(outcome.result_text, &runtime, &error)) {
-        runtime = CalibrationRuntime();
-        runtime.num_framesets = num_framesets;
-        runtime.num_cameras = num_cameras;
-        runtime.error = error;
+      if (with_baseline) {
+        std::cout << "  before (" << options.baseline_executable
+                  << "):" << std::endl;
+        const CalibrationRuntime before = MeasureCalibrationRun(
+            BaselineArguments(base_arguments, options.baseline_executable),
+            request, options.baseline_executable);
+        *all_ok = *all_ok && before.success;
+        PrintCalibrationRun(before);
+        before_runs->push_back(before);
+        std::cout << "  after (this build):" << std::endl;
       }
-      runtime.peak_memory_mb = outcome.peak_memory_mb;
+      const CalibrationRuntime runtime =
+          MeasureCalibrationRun(base_arguments, request, "/proc/self/exe");
       *all_ok = *all_ok && runtime.success;
       PrintCalibrationRun(runtime);
       runs.push_back(runtime);
@@ -234,6 +278,7 @@ std::vector<LocalizationRuntime> RunLocalizations(
 
 std::string RuntimeMarkdown(
     const RuntimeBenchmarkOptions& options, const std::string& machine_before,
+    const std::vector<CalibrationRuntime>& before_runs,
     const std::vector<CalibrationRuntime>& calibration_runs,
     const std::vector<LocalizationRuntime>& localization_runs) {
   std::ostringstream md;
@@ -257,6 +302,15 @@ std::string RuntimeMarkdown(
        << CalibrationRuntimeMarkdown(calibration_runs) << "\n"
        << "![time vs framesets](runtime_calibration.svg)\n\n";
   }
+  if (!before_runs.empty()) {
+    md << "## Before / after\n\n"
+       << "Each configuration ran with `" << options.baseline_executable
+       << "` (before) and then with this build (after), on the same data, "
+          "one after the other in this run"
+       << (options.deterministic_solvers ? "" : " (deterministic_solvers 0)")
+       << ". Ratios > 1: the after build is faster.\n\n"
+       << CalibrationBeforeAfterMarkdown(before_runs, calibration_runs);
+  }
   if (!localization_runs.empty()) {
     md << "## Localization\n\n"
        << "`MapLocalizer::LocalizeImages` from features already in a COLMAP "
@@ -277,6 +331,7 @@ std::string RuntimeMarkdown(
 
 // runtime.md and the CSV and SVG files of the runs there are.
 bool WriteReport(const std::string& folder, const std::string& markdown,
+                 const std::vector<CalibrationRuntime>& before_runs,
                  const std::vector<CalibrationRuntime>& calibration_runs,
                  const std::vector<LocalizationRuntime>& localization_runs) {
   bool written = WriteText(folder + "/runtime.md", markdown);
@@ -285,6 +340,11 @@ bool WriteReport(const std::string& folder, const std::string& markdown,
                         CalibrationRuntimeCsv(calibration_runs)) &&
               WriteText(folder + "/runtime_calibration.svg",
                         CalibrationRuntimeSvg(calibration_runs)) &&
+              written;
+  }
+  if (!before_runs.empty()) {
+    written = WriteText(folder + "/runtime_calibration_before.csv",
+                        CalibrationRuntimeCsv(before_runs)) &&
               written;
   }
   if (!localization_runs.empty()) {
@@ -296,6 +356,7 @@ bool WriteReport(const std::string& folder, const std::string& markdown,
             << (calibration_runs.empty()
                     ? ""
                     : ", runtime_calibration.csv, runtime_calibration.svg")
+            << (before_runs.empty() ? "" : ", runtime_calibration_before.csv")
             << (localization_runs.empty() ? "" : ", runtime_localization.csv")
             << " in " << folder << std::endl;
   return written;
@@ -308,6 +369,12 @@ int RunRuntimeBenchmarkParent(const RuntimeBenchmarkOptions& options,
   RunLists lists;
   std::string error;
   if (!MakeRunLists(options, &lists, &error)) return PrintError(error);
+  if (!options.baseline_executable.empty() &&
+      access(options.baseline_executable.c_str(), X_OK) != 0) {
+    return PrintError("--baseline_executable " + options.baseline_executable +
+                      " is not an executable file (give the path of another "
+                      "rig_calibrator build)");
+  }
   std::error_code code;
   fs::create_directories(options.output_path, code);
   if (code) {
@@ -320,10 +387,10 @@ int RunRuntimeBenchmarkParent(const RuntimeBenchmarkOptions& options,
   std::cout << "Runtime benchmark (" << machine_before << ")" << std::endl;
 
   bool all_ok = true;
-  std::vector<CalibrationRuntime> calibration_runs;
+  std::vector<CalibrationRuntime> before_runs, calibration_runs;
   if (options.calibration) {
-    calibration_runs =
-        RunCalibrations(options, lists, base_arguments, work_dir, &all_ok);
+    calibration_runs = RunCalibrations(options, lists, base_arguments, work_dir,
+                                       &before_runs, &all_ok);
   }
   std::vector<LocalizationRuntime> localization_runs;
   if (options.localization) {
@@ -333,9 +400,9 @@ int RunRuntimeBenchmarkParent(const RuntimeBenchmarkOptions& options,
   fs::remove_all(work_dir, code);
   const bool written =
       WriteReport(options.output_path,
-                  RuntimeMarkdown(options, machine_before, calibration_runs,
-                                  localization_runs),
-                  calibration_runs, localization_runs);
+                  RuntimeMarkdown(options, machine_before, before_runs,
+                                  calibration_runs, localization_runs),
+                  before_runs, calibration_runs, localization_runs);
   return written && all_ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }
 

@@ -53,6 +53,9 @@ void AddCalibrationRunOptions(po::options_description* description,
   AddOption(description, "num_threads", &o->num_threads,
             "threads (-1: all cores)");
   AddOption(description, "seed", &o->seed, "random seed");
+  AddOption(description, "baseline_executable", &o->baseline_executable,
+            "another rig_calibrator build: each calibration run is also made "
+            "with it, first, for a before/after table");
   AddOption(description, "calibration", &o->calibration,
             "measure the calibration core");
   AddOption(description, "localization", &o->localization,

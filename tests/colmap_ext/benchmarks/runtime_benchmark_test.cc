@@ -143,6 +143,31 @@ TEST(RuntimeBenchmark, CsvHasThreeColumnsPerStageAndOneRowPerRun) {
   EXPECT_NE(lines[2].find(",0.125,0.250,0,"), std::string::npos);
 }
 
+TEST(RuntimeBenchmark, BeforeAfterTableGivesRatiosAndErrorChanges) {
+  const CalibrationRuntime before = MakeRun(500, 10, 120.0);
+  CalibrationRuntime after = MakeRun(500, 10, 30.0);
+  after.max_center_error_m = 0.00051;
+  const std::string markdown =
+      CalibrationBeforeAfterMarkdown({before}, {after});
+  // Final BA: 40 (60) [17] before, 10 (15) [17] after: 4x wall and CPU.
+  EXPECT_NE(markdown.find("| Final bundle adjustment | 40.00 (60.00) [17] | "
+                          "10.00 (15.00) [17] | 4.00 | 4.00 |"),
+            std::string::npos)
+      << markdown;
+  // Totals: 80 (120) before, 20 (30) after.
+  EXPECT_NE(markdown.find("| **total** | 80.00 (120.00) | 20.00 (30.00) | "
+                          "4.00 | 4.00 |"),
+            std::string::npos)
+      << markdown;
+  EXPECT_NE(markdown.find("| worst camera center error mm | 0.500 | 0.510 | "
+                          "2.0 % |"),
+            std::string::npos)
+      << markdown;
+  EXPECT_NE(markdown.find("| final RMS px | 0.7050 | 0.7050 | 0.0 % |"),
+            std::string::npos)
+      << markdown;
+}
+
 TEST(RuntimeBenchmark, LocalizationTablesGiveCpuSecondsPerImage) {
   LocalizationRuntime run;
   run.mode = "retrieval";
