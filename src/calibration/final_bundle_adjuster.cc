@@ -57,9 +57,10 @@ constexpr double kFunctionTolerance = 1e-5;
 // A solve whose only use is to tell the outliers from the inliers stops
 // earlier: the residuals that decide the pruning (thresholds of 2 px or
 // more) no longer move once the cost changes by 1e-3 per iteration, and the
-// next solve starts from its result. Issue 14's 500 x 10 scenario: the first
-// solve takes 4 iterations instead of 10, with the same errors against the
-// truth.
+// next solve starts from its result. Issue 14's scenario, 100 framesets x
+// 10 cameras: the first solve takes 4 iterations instead of 11, all solves
+// 13 instead of 15, with the same errors against the truth (0.018 / 0.019
+// deg, 0.76 / 0.75 mm).
 constexpr double kPruningFunctionTolerance = 1e-3;
 
 // The first solve, then prune-and-resolve rounds until a round prunes

@@ -33,8 +33,9 @@ struct RadialBundleAdjustmentOptions {
   // final bundle adjustment, and a rig pose has 6 unknowns, a camera 7: at
   // most this many of an image's correspondences take part (evenly spaced
   // over the image's inliers, so the selection is fixed for given data).
-  // Issue 14's 500 framesets x 10 cameras: radial BA 3x faster with the
-  // same final errors against the truth. 0: all.
+  // Issue 14's scenario, 100 framesets x 10 cameras: radial BA CPU time
+  // 4.6 -> 2.2 s, the same number of iterations and the same final errors
+  // against the truth. 0: all.
   int max_correspondences_per_image = 100;
   int num_threads = -1;
   bool print_progress = false;  // Ceres per-iteration progress on stdout
