@@ -7,18 +7,9 @@
 namespace rig_calibrator {
 namespace {
 
-constexpr int kDescriptorDim = 128;
 constexpr float kHalfPi = static_cast<float>(M_PI / 2);
 
 }  // namespace
-
-int SiftDescriptorDot(const uint8_t* descriptor1, const uint8_t* descriptor2) {
-  int dot = 0;
-  for (int i = 0; i < kDescriptorDim; ++i) {
-    dot += static_cast<int>(descriptor1[i]) * static_cast<int>(descriptor2[i]);
-  }
-  return dot;
-}
 
 float SiftDotToAngle(const int dot) {
   // COLMAP normalizes SIFT descriptors to length 512 before the uint8

@@ -23,8 +23,16 @@
 
 namespace rig_calibrator {
 
-// The dot product of two 128-byte SIFT descriptors.
-int SiftDescriptorDot(const uint8_t* descriptor1, const uint8_t* descriptor2);
+// The dot product of two 128-byte SIFT descriptors (inline: the guided
+// matcher's inner loop).
+inline int SiftDescriptorDot(const uint8_t* descriptor1,
+                             const uint8_t* descriptor2) {
+  int dot = 0;
+  for (int i = 0; i < 128; ++i) {
+    dot += static_cast<int>(descriptor1[i]) * static_cast<int>(descriptor2[i]);
+  }
+  return dot;
+}
 
 // The angle of descriptors with dot product `dot`: acos(min(dot / 512^2, 1)).
 float SiftDotToAngle(int dot);

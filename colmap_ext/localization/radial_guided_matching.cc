@@ -8,8 +8,7 @@ namespace rig_calibrator {
 RadialLineIndex::RadialLineIndex(
     const LocalizationMap& map, const PointDescriptorIndex& index,
     const std::vector<colmap::point3D_t>& point3D_ids,
-    const Rigid3d& cam_from_world)
-    : index_(&index) {
+    const Rigid3d& cam_from_world) {
   const Eigen::Matrix3d rotation = cam_from_world.RotationMatrix();
   points_.reserve(point3D_ids.size());
   for (const colmap::point3D_t point3D_id : point3D_ids) {
@@ -34,6 +33,19 @@ RadialLineIndex::RadialLineIndex(
               return a.direction < b.direction || (a.direction == b.direction &&
                                                    a.point3D_id < b.point3D_id);
             });
+  constexpr int kDim = 128;
+  int num_rows = 0;
+  for (const LinePoint& point : points_) num_rows += point.num_rows;
+  descriptors_.resize(static_cast<size_t>(num_rows) * kDim);
+  int row = 0;
+  for (LinePoint& point : points_) {
+    for (int r = 0; r < point.num_rows; ++r) {
+      std::copy_n(index.Descriptor(point.first_row + r), kDim,
+                  descriptors_.data() + static_cast<size_t>(row + r) * kDim);
+    }
+    point.first_row = row;
+    row += point.num_rows;
+  }
 }
 
 void RadialLineIndex::Match(
@@ -68,7 +80,9 @@ void RadialLineIndex::Match(
         if (along <= 0 || std::abs(across) > tolerance) continue;
         int dot = 0;
         for (int r = it->first_row; r < it->first_row + it->num_rows; ++r) {
-          dot = std::max(dot, SiftDescriptorDot(query, index_->Descriptor(r)));
+          dot = std::max(
+              dot, SiftDescriptorDot(query, descriptors_.data() +
+                                                static_cast<size_t>(r) * 128));
         }
         if (dot > best_dot) {
           second_dot = best_dot;

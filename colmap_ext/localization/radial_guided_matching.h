@@ -45,7 +45,7 @@ class RadialLineIndex {
  public:
   // `point3D_ids`: points of `map`; those without descriptors in `index`
   // and those projecting within 1e-9 of the center (on the optical axis) are
-  // left out. `index` must outlive this object.
+  // left out.
   RadialLineIndex(const LocalizationMap& map, const PointDescriptorIndex& index,
                   const std::vector<colmap::point3D_t>& point3D_ids,
                   const Rigid3d& cam_from_world);
@@ -68,11 +68,14 @@ class RadialLineIndex {
     double direction = 0;  // atan2 of the unit radial projection, (-pi, pi]
     Eigen::Vector2d unit = Eigen::Vector2d::Zero();
     colmap::point3D_t point3D_id = colmap::kInvalidPoint3DId;
-    int first_row = 0;  // of its descriptors in the index
+    int first_row = 0;  // of its descriptors in descriptors_
     int num_rows = 0;
   };
-  const PointDescriptorIndex* index_;
-  std::vector<LinePoint> points_;  // by direction, then point3D_id
+  std::vector<LinePoint> points_;
+  // The points' descriptors copied from the index in the order of points_,
+  // so that a window of directions reads contiguous memory (the index's rows
+  // of neighbouring directions are scattered over the whole map).
+  std::vector<uint8_t> descriptors_;  // by direction, then point3D_id
 };
 
 }  // namespace rig_calibrator
