@@ -140,8 +140,9 @@ TEST(RadialLineIndexTest, MatchesPointsNearTheRadialLineOnItsSide) {
   map.points[2].xyz = Eigen::Vector3d(0, 1, 5);
   colmap::FeatureDescriptors point_descriptors(2, 128);
   point_descriptors.setZero();
-  point_descriptors(0, 0) = 255;  // point 1: bin 0
-  point_descriptors(1, 1) = 255;  // point 2: bin 1
+  // Norm ~512 as COLMAP's: point 1 in bins 0-3, point 2 in bins 4-7.
+  point_descriptors.block(0, 0, 1, 4).setConstant(255);
+  point_descriptors.block(1, 4, 1, 4).setConstant(255);
   PointDescriptorIndex index;
   index.SetDescriptors(point_descriptors, {1, 2});
   const RadialLineIndex lines(map, index, {1, 2, 3}, Rigid3d());
@@ -151,7 +152,7 @@ TEST(RadialLineIndexTest, MatchesPointsNearTheRadialLineOnItsSide) {
   // 10 px off it, on the opposite side (-x), near the center.
   colmap::FeatureDescriptors query(5, 128);
   query.setZero();
-  query.col(0).setConstant(255);
+  query.leftCols(4).setConstant(255);
   const std::vector<Eigen::Vector2d> points2D = {
       {100, 0}, {100, 5}, {100, 10}, {-100, 0}, {3, 0}};
   RadialGuidedMatchingOptions options;
@@ -163,7 +164,9 @@ TEST(RadialLineIndexTest, MatchesPointsNearTheRadialLineOnItsSide) {
   EXPECT_EQ(matches[1].query_idx, 1u);
   for (const auto& match : matches) {
     EXPECT_EQ(match.point3D_id, 1u);
-    EXPECT_NEAR(match.angle, 0, 1e-3);
+    // The norm is 510, not 512.
+    EXPECT_NEAR(match.angle, std::acos(4 * 255.0 * 255.0 / (512.0 * 512.0)),
+                1e-6);
   }
 
   // A window across +-pi: point 4 at direction ~pi.
