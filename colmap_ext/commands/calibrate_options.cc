@@ -123,6 +123,21 @@ void AddLocalizationOptions(po::options_description* description,
   AddOption(description, "Localization.max_descriptors_per_point",
             &o->max_descriptors_per_point,
             "direct mode: descriptors indexed per map point");
+  AddOption(description, "Localization.guided", &o->guidance.enabled,
+            "direct mode: search the strongest features first and, once the "
+            "image's 1D radial pose is certain, match the rest only to the "
+            "map points near their radial lines (0: search every feature)");
+  AddOption(description, "Localization.guided_batch_size",
+            &o->guidance.batch_size,
+            "direct mode: features searched per batch before the pose is "
+            "certain");
+  AddOption(description, "Localization.guided_min_pose_inliers",
+            &o->guidance.min_pose_inliers,
+            "direct mode: radial pose inliers that make the pose certain");
+  AddOption(description, "Localization.guided_max_line_distance",
+            &o->guidance.max_line_distance_px,
+            "direct mode: largest distance of a guided match from the "
+            "point's radial line (pixels)");
   AddOption(description, "Localization.use_database_matches",
             &o->use_database_matches,
             "use matches a COLMAP matcher already stored between rig and map "
@@ -138,6 +153,12 @@ void AddLocalizationOptions(po::options_description* description,
 }
 
 }  // namespace
+
+po::options_description DescribeLocalizationOptions(CalibrateOptions* options) {
+  po::options_description description("localization options");
+  AddLocalizationOptions(&description, options);
+  return description;
+}
 
 po::options_description DescribeCalibrateOptions(CalibrateOptions* options) {
   po::options_description description =
@@ -242,6 +263,7 @@ bool MakeLocalizerOptions(const CalibrateOptions& options,
   localizer_options->max_descriptors_per_point =
       options.max_descriptors_per_point;
   localizer_options->use_database_matches = options.use_database_matches;
+  localizer_options->guidance = options.guidance;
   localizer_options->num_threads = options.num_threads;
   return localizer_options->Check(error);
 }

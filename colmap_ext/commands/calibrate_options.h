@@ -60,6 +60,7 @@ struct CalibrateOptions {
   int max_descriptors_per_point =
       MapLocalizerOptions().max_descriptors_per_point;
   bool use_database_matches = true;
+  MapLocalizerOptions::Guidance guidance;
   colmap::SiftMatchingOptions sift_matching;
 
   bool FromCorrespondences() const { return !correspondences_path.empty(); }
@@ -74,6 +75,11 @@ struct CalibrateOptions {
 
 // The command-line options, bound to the fields of *options.
 boost::program_options::options_description DescribeCalibrateOptions(
+    CalibrateOptions* options);
+
+// The Localization.* and SiftMatching.* options alone (also those of
+// `rig_calibrator benchmark_localization`).
+boost::program_options::options_description DescribeLocalizationOptions(
     CalibrateOptions* options);
 
 // Checks the combination of inputs, upper-cases output_type and sets

@@ -25,4 +25,8 @@ int RunBenchmark(int argc, char** argv);
 // (runtime_benchmark_command.cc).
 int RunRuntimeBenchmark(int argc, char** argv);
 
+// Localization throughput on a COLMAP map, one configuration per run
+// (localization_benchmark_command.cc).
+int RunLocalizationBenchmark(int argc, char** argv);
+
 }  // namespace rig_calibrator

@@ -38,6 +38,9 @@ Commands() {
           {"benchmark_runtime",
            {&RunRuntimeBenchmark,
             "time and memory of the calibration and the localization"}},
+          {"benchmark_localization",
+           {&RunLocalizationBenchmark,
+            "localization throughput on a COLMAP map"}},
       };
   return commands;
 }

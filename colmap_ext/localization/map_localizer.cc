@@ -76,6 +76,12 @@ bool MapLocalizerOptions::Check(std::string* error) const {
   if (index.num_trees < 1 || index.num_checks < 1) {
     return fail("index num_trees and num_checks must be >= 1");
   }
+  if (guidance.batch_size < 1 || guidance.min_pose_inliers < 5 ||
+      !(guidance.max_line_distance_px > 0)) {
+    return fail(
+        "guidance needs batch_size >= 1, min_pose_inliers >= 5 and "
+        "max_line_distance_px > 0");
+  }
   if (num_retrieved_images < 1)
     return fail("num_retrieved_images must be >= 1");
   if (max_num_map_images_exhaustive < 0) {
@@ -267,12 +273,9 @@ bool MapLocalizer::LocalizeImage(const DatabaseImage& image,
   }
   if (candidates.empty() && descriptors.rows() > 0) {
     if (options_.mode == LocalizationMode::kDirect) {
-      std::vector<PointDescriptorIndex::PointMatch> matches;
-      point_index_.Match(descriptors, options_.sift_matching.max_ratio,
-                         options_.sift_matching.max_distance, &matches);
-      for (const PointDescriptorIndex::PointMatch& match : matches) {
-        candidates.push_back(
-            {match.query_idx, match.point3D_id, 1, match.angle});
+      if (!MatchDirectly(image, keypoints, descriptors, &candidates, result,
+                         error)) {
+        return false;
       }
       result->source = CorrespondenceSource::kDirectIndex;
     } else {

@@ -7,26 +7,20 @@
 namespace rig_calibrator {
 namespace {
 
-constexpr int kDescriptorDim = 128;
 constexpr float kHalfPi = static_cast<float>(M_PI / 2);
-
-int DescriptorDot(const uint8_t* descriptor1, const uint8_t* descriptor2) {
-  int dot = 0;
-  for (int i = 0; i < kDescriptorDim; ++i) {
-    dot += static_cast<int>(descriptor1[i]) * static_cast<int>(descriptor2[i]);
-  }
-  return dot;
-}
 
 }  // namespace
 
-float SiftDescriptorAngle(const uint8_t* descriptor1,
-                          const uint8_t* descriptor2) {
+float SiftDotToAngle(const int dot) {
   // COLMAP normalizes SIFT descriptors to length 512 before the uint8
   // conversion (feature/utils.cc), hence the 1 / 512^2.
   constexpr float kDotNorm = 1.0f / (512.0f * 512.0f);
-  return std::acos(
-      std::min(kDotNorm * DescriptorDot(descriptor1, descriptor2), 1.0f));
+  return std::acos(std::min(kDotNorm * dot, 1.0f));
+}
+
+float SiftDescriptorAngle(const uint8_t* descriptor1,
+                          const uint8_t* descriptor2) {
+  return SiftDotToAngle(SiftDescriptorDot(descriptor1, descriptor2));
 }
 
 std::vector<int> SelectRepresentativeDescriptors(
@@ -148,6 +142,12 @@ void PointDescriptorIndex::Match(const colmap::FeatureDescriptors& query,
     match.angle = best_angle;
     matches->push_back(match);
   }
+}
+
+std::pair<int, int> PointDescriptorIndex::PointRows(
+    const colmap::point3D_t point3D_id) const {
+  const auto it = point_rows_.find(point3D_id);
+  return it == point_rows_.end() ? std::make_pair(0, 0) : it->second;
 }
 
 float PointDescriptorIndex::AngleToPoint(

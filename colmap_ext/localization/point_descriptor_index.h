@@ -23,6 +23,20 @@
 
 namespace rig_calibrator {
 
+// The dot product of two 128-byte SIFT descriptors (inline: the guided
+// matcher's inner loop).
+inline int SiftDescriptorDot(const uint8_t* descriptor1,
+                             const uint8_t* descriptor2) {
+  int dot = 0;
+  for (int i = 0; i < 128; ++i) {
+    dot += static_cast<int>(descriptor1[i]) * static_cast<int>(descriptor2[i]);
+  }
+  return dot;
+}
+
+// The angle of descriptors with dot product `dot`: acos(min(dot / 512^2, 1)).
+float SiftDotToAngle(int dot);
+
 // COLMAP's SIFT descriptor distance: the angle between the two 128-byte
 // descriptors, acos(min(a.b / 512^2, 1)).
 float SiftDescriptorAngle(const uint8_t* descriptor1,
@@ -86,6 +100,13 @@ class PointDescriptorIndex {
   // safe to call from several threads at once.
   void Match(const colmap::FeatureDescriptors& query, double max_ratio,
              double max_distance, std::vector<PointMatch>* matches) const;
+
+  // The rows [first, first + count) of the point's descriptors; {0, 0} if the
+  // point is not in the index.
+  std::pair<int, int> PointRows(colmap::point3D_t point3D_id) const;
+  const uint8_t* Descriptor(int row) const {
+    return descriptors_.row(row).data();
+  }
 
   // Smallest SiftDescriptorAngle between `descriptor` and the descriptors of
   // the point; pi/2 (orthogonal) if the point is not in the index.
