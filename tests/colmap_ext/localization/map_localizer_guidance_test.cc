@@ -86,7 +86,9 @@ TEST_F(MapLocalizerGuidanceTest, FindsWhatTheFullSearchFinds) {
   MapLocalizerOptions unguided;
   unguided.guidance.enabled = false;
   const Counts full = Count(Localize(unguided));
-  const Counts guided = Count(Localize(MapLocalizerOptions()));
+  MapLocalizerOptions guided_options;
+  guided_options.guidance.enabled = true;
+  const Counts guided = Count(Localize(guided_options));
   std::cout << "full search: " << full.correct << " correct, " << full.wrong
             << " wrong; guided: " << guided.correct << " correct, "
             << guided.wrong << " wrong, " << guided.guided
@@ -103,6 +105,7 @@ TEST_F(MapLocalizerGuidanceTest, NeverCertainIsTheFullSearch) {
   MapLocalizerOptions unguided;
   unguided.guidance.enabled = false;
   MapLocalizerOptions never_certain;
+  never_certain.guidance.enabled = true;
   never_certain.guidance.min_pose_inliers = 100000;
   const std::vector<ImageLocalization> a = Localize(unguided);
   const std::vector<ImageLocalization> b = Localize(never_certain);
@@ -115,6 +118,7 @@ TEST_F(MapLocalizerGuidanceTest, NeverCertainIsTheFullSearch) {
 
 TEST_F(MapLocalizerGuidanceTest, SameOnOneAndTwoThreads) {
   MapLocalizerOptions options;
+  options.guidance.enabled = true;
   options.index.num_checks = 8;  // approximate: depends on the forest
   options.num_threads = 1;
   const std::vector<ImageLocalization> one = Localize(options);
