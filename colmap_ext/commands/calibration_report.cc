@@ -3,7 +3,27 @@
 #include <iomanip>
 #include <iostream>
 
+#include "colmap_ext/io/uncertainty_json.h"
+
 namespace rig_calibrator {
+namespace {
+
+std::vector<std::string> CameraNames(const CalibrationSummary& summary) {
+  std::vector<std::string> names;
+  for (const CameraSummary& camera : summary.cameras)
+    names.push_back(camera.name);
+  return names;
+}
+
+std::vector<colmap::Camera> CameraModels(const CalibrationSummary& summary) {
+  std::vector<colmap::Camera> cameras;
+  for (const CameraSummary& camera : summary.cameras) {
+    cameras.push_back(camera.camera);
+  }
+  return cameras;
+}
+
+}  // namespace
 
 CalibrationSummary MakeCalibrationSummary(
     const RigDataset& dataset, const RigCalibration& calibration,
@@ -15,6 +35,7 @@ CalibrationSummary MakeCalibrationSummary(
   CompareWithKnownRig(known_rig, &summary);
   summary.method = CalibrationMethodName(report.used_method);
   summary.seed = seed;
+  summary.uncertainty = report.uncertainty;
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);
@@ -53,6 +74,10 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
               << ", " << center.z() << ") images " << camera.num_used << "/"
               << camera.num_images << " RMS " << std::setprecision(3)
               << camera.rms_px << " px\n";
+  }
+  for (const std::string& line : UncertaintyLines(
+           CameraNames(summary), CameraModels(summary), summary.uncertainty)) {
+    std::cout << "  " << line << "\n";
   }
   if (!summary.known_rig_source.empty()) {
     std::cout << "  against the known rig of " << summary.known_rig_source

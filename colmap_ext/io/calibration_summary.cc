@@ -5,6 +5,7 @@
 
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/rig_description.h"
+#include "colmap_ext/io/uncertainty_json.h"
 
 namespace rig_calibrator {
 
@@ -151,6 +152,7 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     cameras.push_back(node);
   }
   root["cameras"] = cameras;
+  AddUncertaintyJson(summary.uncertainty, &root);
   if (summary.known_rig_source.empty()) {
     root["known_rig"] = nullptr;
   } else {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "src/calibration/rig_dataset.h"
+#include "src/evaluation/calibration_uncertainty.h"
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
@@ -85,6 +86,7 @@ struct CalibrationSummary {
   // Stage, wall seconds: written by WriteTimingsJson only.
   std::vector<std::pair<std::string, double>> timings_s;
   std::optional<MapImagesSummary> map_images;  // with a map
+  CalibrationUncertainty uncertainty;          // of the pipeline's report
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -311,6 +311,9 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
            << " px over the image.\n";
       file_notes.push_back(note);
     }
+    for (const std::string& comment : camera.comments) {
+      yaml << "# " << comment << "\n";
+    }
     yaml << key << ":\n";
     if (previous_cam_from_rig != nullptr) {
       const Eigen::Matrix<double, 3, 4> t =

@@ -18,6 +18,7 @@
 #include "colmap_ext/io/model_errors.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
+#include "colmap_ext/io/uncertainty_json.h"
 
 namespace rig_calibrator {
 namespace {
@@ -480,8 +481,10 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
     return false;
   }
   std::string camchain_error;
-  if (!WriteCamchainYaml(folder + "/" + kCamchainFile, rig, &contents->notes,
-                         &camchain_error)) {
+  RigDescription commented_rig = rig;
+  AddUncertaintyComments(summary.uncertainty, &commented_rig);
+  if (!WriteCamchainYaml(folder + "/" + kCamchainFile, commented_rig,
+                         &contents->notes, &camchain_error)) {
     contents->notes.push_back(std::string(kCamchainFile) +
                               " is not written: " + camchain_error);
   }

@@ -25,6 +25,9 @@ struct RigDescriptionCamera {
   // Relative to the reference camera; unknown for a camera that could not be
   // calibrated (or that a file leaves out).
   std::optional<Rigid3d> cam_from_rig;
+  // Lines written as comments with the camera in the formats that allow
+  // them (camchain.yaml), e.g. the uncertainty (uncertainty_json.h).
+  std::vector<std::string> comments;
 };
 
 struct RigDescription {

@@ -115,6 +115,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
                                 report)) {
     return false;
   }
+  RunUncertaintyEstimation(options, method, dataset, *calibration, report);
   SummarizeCalibration(dataset, *calibration, report);
   report->total_seconds = total_timer.ElapsedSeconds();
   return true;

@@ -11,6 +11,7 @@
 
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/evaluation/calibration_uncertainty.h"
 
 namespace rig_calibrator {
 
@@ -52,6 +53,9 @@ struct PipelineReport {
   std::vector<colmap::Camera> initial_cameras;
   std::vector<Rigid3d> initial_cam_from_rig;
   std::vector<bool> initial_camera_calibrated;
+  // The uncertainty of the final calibration (computed after the final
+  // bundle adjustment).
+  CalibrationUncertainty uncertainty;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

@@ -257,13 +257,9 @@ bool RunFullPoseRigInitialization(
   return true;
 }
 
-bool RunFinalBundleAdjustment(const PipelineOptions& options,
-                              CalibrationMethod method,
-                              const RigDataset& dataset,
-                              RigCalibration* calibration,
-                              PipelineReport* report) {
-  StageTimer stage("Final bundle adjustment", options.print_progress, report);
-  SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
+FinalBundleAdjustmentOptions FinalBundleAdjustmentOptionsFor(
+    const PipelineOptions& options, CalibrationMethod method,
+    const RigDataset& dataset) {
   FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
   ba_options.num_threads = options.SolverNumThreads();
   // Map images can all be missing although there is a map (e.g. its cameras
@@ -277,6 +273,18 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
     ba_options.refine_principal_point = false;
     ba_options.refine_extra_params = false;
   }
+  return ba_options;
+}
+
+bool RunFinalBundleAdjustment(const PipelineOptions& options,
+                              CalibrationMethod method,
+                              const RigDataset& dataset,
+                              RigCalibration* calibration,
+                              PipelineReport* report) {
+  StageTimer stage("Final bundle adjustment", options.print_progress, report);
+  SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
+  const FinalBundleAdjustmentOptions ba_options =
+      FinalBundleAdjustmentOptionsFor(options, method, dataset);
   FinalBundleAdjustmentSummary summary;
   if (!AdjustRig(ba_options, dataset, calibration, &summary)) {
     report->error = "the final bundle adjustment failed (see above)";
@@ -299,6 +307,33 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
     }
   }
   return true;
+}
+
+void RunUncertaintyEstimation(const PipelineOptions& options,
+                              CalibrationMethod method,
+                              const RigDataset& dataset,
+                              const RigCalibration& calibration,
+                              PipelineReport* report) {
+  StageTimer stage("Uncertainty", options.print_progress, report);
+  report->uncertainty = EstimateCalibrationUncertainty(
+      FinalBundleAdjustmentOptionsFor(options, method, dataset), dataset,
+      calibration);
+  for (const Diagnostic& diagnostic :
+       UncertaintyDiagnostics(dataset, calibration, report->uncertainty)) {
+    report->diagnostics.push_back(diagnostic);
+  }
+  if (options.print_progress) {
+    const CalibrationUncertainty& uncertainty = report->uncertainty;
+    if (uncertainty.computed) {
+      std::cout << "  residual scale " << uncertainty.residual_scale_px
+                << " px (effective " << uncertainty.effective_scale_px
+                << " px), " << uncertainty.num_residuals << " residuals, "
+                << uncertainty.num_parameters << " parameters, "
+                << uncertainty.seconds << " s" << std::endl;
+    } else {
+      std::cout << "  not computed: " << uncertainty.message << std::endl;
+    }
+  }
 }
 
 }  // namespace rig_calibrator

@@ -25,12 +25,27 @@ bool RunFullPoseRigInitialization(
     const std::vector<colmap::Camera>& per_image_cameras,
     RigCalibration* calibration, PipelineReport* report);
 
+// The final bundle adjustment's options for `method` (refinement switches,
+// threads, map adjustment only with map images).
+FinalBundleAdjustmentOptions FinalBundleAdjustmentOptionsFor(
+    const PipelineOptions& options, CalibrationMethod method,
+    const RigDataset& dataset);
+
 // The final bundle adjustment over the full inliers of the current rig;
 // the intrinsics are held for known and known_ra.
 bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               CalibrationMethod method,
                               const RigDataset& dataset,
                               RigCalibration* calibration,
+                              PipelineReport* report);
+
+// The uncertainty of the final bundle adjustment's result
+// (src/evaluation/calibration_uncertainty.h) into report->uncertainty, and
+// its diagnostics. Never fails the calibration.
+void RunUncertaintyEstimation(const PipelineOptions& options,
+                              CalibrationMethod method,
+                              const RigDataset& dataset,
+                              const RigCalibration& calibration,
                               PipelineReport* report);
 
 }  // namespace rig_calibrator

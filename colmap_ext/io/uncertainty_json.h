@@ -1,0 +1,40 @@
+// The uncertainty of a calibration (src/evaluation/calibration_uncertainty.h)
+// in the outputs: the "uncertainty" of every camera and the top-level
+// "uncertainty_method" of calibration_summary.json, the comment lines of
+// camchain.yaml, and the terminal lines of the result. Pixels are COLMAP's;
+// standard deviations do not depend on the pixel convention.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/io/rig_description.h"
+#include "src/evaluation/calibration_uncertainty.h"
+
+namespace rig_calibrator {
+
+// Per camera c of root["cameras"] (the dataset's order) its
+// "uncertainty": {residual_scale_px, params_stddev (0: held, null:
+// undetermined), rotation_stddev_deg (sqrt of the trace of the rotation
+// vector's covariance), rotation_axis_stddev_deg, translation_stddev,
+// center_in_rig_stddev, projection_stddev_px: {median, max, max_at, depth,
+// grid: {cols, rows, values (row-major, cell centres, null where the model
+// does not unproject)}}}, null for a camera without one; and
+// root["uncertainty_method"] (what was computed, or why not). Never NaN.
+void AddUncertaintyJson(const CalibrationUncertainty& uncertainty,
+                        nlohmann::ordered_json* root);
+
+// Comment lines (without "# ") for each calibrated camera of `rig`
+// (RigDescriptionCamera::comments), in the dataset's camera order.
+void AddUncertaintyComments(const CalibrationUncertainty& uncertainty,
+                            RigDescription* rig);
+
+// The lines of the terminal result: per camera sigma of the focal length(s),
+// principal point, rotation and centre, and the projection uncertainty.
+std::vector<std::string> UncertaintyLines(
+    const std::vector<std::string>& camera_names,
+    const std::vector<colmap::Camera>& cameras,
+    const CalibrationUncertainty& uncertainty);
+
+}  // namespace rig_calibrator
