@@ -3,6 +3,9 @@
 #include <iomanip>
 #include <iostream>
 
+#include "colmap_ext/commands/camera_model_lines.h"
+#include "colmap_ext/io/model_validity_json.h"
+
 namespace rig_calibrator {
 
 CalibrationSummary MakeCalibrationSummary(
@@ -13,6 +16,7 @@ CalibrationSummary MakeCalibrationSummary(
   CalibrationSummary summary =
       SummarizeCalibration(dataset, calibration, image_prefixes);
   CompareWithKnownRig(known_rig, &summary);
+  AttachCameraModelReports(report, &summary);
   summary.method = CalibrationMethodName(report.used_method);
   summary.seed = seed;
   for (const Diagnostic& diagnostic : report.diagnostics) {
@@ -66,6 +70,7 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
                 << ")\n";
     }
   }
+  PrintCameraModelLines(summary);
   for (const Diagnostic& diagnostic : report.diagnostics) {
     std::cout << "  " << DiagnosticLevelName(diagnostic.level) << ": "
               << diagnostic.message << "\n";

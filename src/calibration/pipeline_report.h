@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "src/calibration/calibration_method.h"
+#include "src/calibration/camera_model_report.h"
 #include "src/calibration/rig_dataset.h"
 
 namespace rig_calibrator {
@@ -49,6 +50,9 @@ struct PipelineReport {
   std::vector<colmap::Camera> initial_cameras;
   std::vector<Rigid3d> initial_cam_from_rig;
   std::vector<bool> initial_camera_calibrated;
+  // Per dataset camera: its model's validity and automatic choice (empty
+  // when the pipeline stopped before the final bundle adjustment).
+  std::vector<CameraModelReport> camera_models;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 
