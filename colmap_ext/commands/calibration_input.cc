@@ -167,9 +167,9 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
     // only its principal point, the full-pose methods' single-image fits
     // its model until the choice.
     camera.choose_model = models[c] == kAutoCameraModel;
-    camera.camera.InitializeWithName(
-        camera.choose_model ? "OPENCV" : models[c],
-        1.2 * std::max(width, height), width, height);
+    camera.camera.InitializeWithName(camera.choose_model ? "OPENCV" : models[c],
+                                     1.2 * std::max(width, height), width,
+                                     height);
     dataset->cameras.push_back(camera);
   }
   dataset->frameset_names = layout->frameset_names;
