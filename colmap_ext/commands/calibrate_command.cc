@@ -134,7 +134,9 @@ int RunCalibrate(int argc, char** argv) {
                "timings.json."
             << std::endl;
   if (report.HasErrors()) {
-    return PrintError("some cameras could not be calibrated (see above)");
+    return PrintError(
+        "some cameras could not be calibrated or have a camera model that is "
+        "not valid over the whole image (see above)");
   }
   return EXIT_SUCCESS;
 }

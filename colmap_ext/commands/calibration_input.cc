@@ -17,6 +17,7 @@
 #include "colmap_ext/io/rig_reference_io.h"
 #include "colmap_ext/localization/map_localizer.h"
 #include "src/calibration/camera_upgrader.h"
+#include "src/calibration/model_selection.h"
 
 namespace rig_calibrator {
 namespace {
@@ -66,7 +67,8 @@ bool ListImages(const std::string& image_path, std::vector<std::string>* names,
   return true;
 }
 
-// "OPENCV" for every camera, or "cam0:OPENCV,cam1:OPENCV_FISHEYE".
+// "OPENCV" for every camera, or "cam0:OPENCV,cam1:OPENCV_FISHEYE"; "auto"
+// (kAutoCameraModel) where the pipeline chooses the model.
 bool CameraModels(const std::string& value,
                   const std::vector<std::string>& camera_names,
                   std::vector<std::string>* models, std::string* error) {
@@ -99,13 +101,14 @@ bool CameraModels(const std::string& value,
                camera_names[c];
       return false;
     }
+    if (model == kAutoCameraModel) continue;
     if (!colmap::ExistsCameraModelWithName(model) ||
         !IsUpgradeSupportedCameraModel(colmap::CameraModelNameToId(model))) {
       *error = "unknown or unsupported camera model '" + model +
                "' for camera " + camera_names[c] +
                "; supported: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, "
                "OPENCV, OPENCV_FISHEYE, FULL_OPENCV, SIMPLE_RADIAL_FISHEYE, "
-               "RADIAL_FISHEYE";
+               "RADIAL_FISHEYE, THIN_PRISM_FISHEYE, or auto";
       return false;
     }
   }
@@ -160,8 +163,13 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
     // COLMAP's default initialization: focal 1.2 max(w, h), principal point
     // at the image center. Only the principal point is used before the
     // upgrade estimates the rest.
-    camera.camera.InitializeWithName(models[c], 1.2 * std::max(width, height),
-                                     width, height);
+    // An automatically chosen model starts as OPENCV: the radial stages use
+    // only its principal point, the full-pose methods' single-image fits
+    // its model until the choice.
+    camera.choose_model = models[c] == kAutoCameraModel;
+    camera.camera.InitializeWithName(camera.choose_model ? "OPENCV" : models[c],
+                                     1.2 * std::max(width, height), width,
+                                     height);
     dataset->cameras.push_back(camera);
   }
   dataset->frameset_names = layout->frameset_names;
@@ -244,6 +252,7 @@ bool SetKnownIntrinsics(const CalibrateOptions& options,
     }
     camera.camera = intrinsics;
     camera.intrinsics_known = true;
+    camera.choose_model = false;
   }
   return true;
 }

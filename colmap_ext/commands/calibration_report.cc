@@ -3,6 +3,8 @@
 #include <iomanip>
 #include <iostream>
 
+#include "colmap_ext/commands/camera_model_lines.h"
+#include "colmap_ext/io/model_validity_json.h"
 #include "colmap_ext/io/uncertainty_json.h"
 
 namespace rig_calibrator {
@@ -33,6 +35,7 @@ CalibrationSummary MakeCalibrationSummary(
   CalibrationSummary summary =
       SummarizeCalibration(dataset, calibration, image_prefixes);
   CompareWithKnownRig(known_rig, &summary);
+  AttachCameraModelReports(report, &summary);
   summary.method = CalibrationMethodName(report.used_method);
   summary.seed = seed;
   summary.uncertainty = report.uncertainty;
@@ -91,6 +94,7 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
                 << ")\n";
     }
   }
+  PrintCameraModelLines(summary);
   for (const Diagnostic& diagnostic : report.diagnostics) {
     std::cout << "  " << DiagnosticLevelName(diagnostic.level) << ": "
               << diagnostic.message << "\n";

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "src/calibration/camera_model_report.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/evaluation/calibration_uncertainty.h"
 #include "src/geometry/rigid3d.h"
@@ -33,6 +34,8 @@ struct CameraSummary {
   // Root mean square over the inliers of all used images.
   double radial_rms_px = 0;
   double rms_px = 0;
+  // Validity of the model and its automatic choice (model_validity_json.h).
+  CameraModelReport camera_model;
 };
 
 // Known cam_from_rig of the rig cameras, e.g. the sensor_from_rig of a

@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "src/calibration/camera_model_stage.h"
 #include "src/calibration/pipeline_stages.h"
 
 namespace rig_calibrator {
@@ -107,6 +108,8 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
                                            per_image_cameras, calibration,
                                            report)) {
     return false;
+  } else {
+    ChooseCameraModelsFromPoses(options, dataset, calibration, report);
   }
   report->initial_cameras = calibration->cameras;
   report->initial_cam_from_rig = calibration->cam_from_rig;
@@ -115,6 +118,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
                                 report)) {
     return false;
   }
+  CheckCameraModels(options, dataset, *calibration, report);
   RunUncertaintyEstimation(options, method, dataset, *calibration, report);
   SummarizeCalibration(dataset, *calibration, report);
   report->total_seconds = total_timer.ElapsedSeconds();

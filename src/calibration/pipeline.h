@@ -19,6 +19,7 @@
 #include "src/calibration/camera_upgrader.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
+#include "src/calibration/model_selection.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/calibration/principal_axes.h"
 #include "src/calibration/radial_bundle_adjuster.h"
@@ -40,6 +41,7 @@ struct PipelineOptions {
   RigInitializerOptions rig_initializer;
   RadialBundleAdjustmentOptions radial_bundle_adjustment;
   CameraUpgradeOptions upgrade;
+  ModelSelectionOptions model_selection;  // cameras with choose_model
   FinalBundleAdjustmentOptions final_bundle_adjustment;
 
   // Correspondences within this radial error of the refined radial rig are

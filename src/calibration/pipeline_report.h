@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "src/calibration/calibration_method.h"
+#include "src/calibration/camera_model_report.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/evaluation/calibration_uncertainty.h"
 
@@ -56,6 +57,9 @@ struct PipelineReport {
   // The uncertainty of the final calibration (computed after the final
   // bundle adjustment).
   CalibrationUncertainty uncertainty;
+  // Per dataset camera: its model's validity and automatic choice (empty
+  // when the pipeline stopped before the final bundle adjustment).
+  std::vector<CameraModelReport> camera_models;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

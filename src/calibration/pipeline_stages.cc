@@ -6,6 +6,7 @@
 #include <iostream>
 #include <utility>
 
+#include "src/calibration/camera_model_stage.h"
 #include "src/calibration/complete_frameset_initialization.h"
 #include "src/calibration/inlier_selection.h"
 
@@ -115,17 +116,19 @@ void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
   std::vector<UpgradeInput> inputs(num_cameras);
   std::vector<CameraUpgradeResult> results(num_cameras);
   std::vector<char> success(num_cameras, 0);
+  std::vector<std::optional<ModelChoice>> choices(num_cameras);
 #pragma omp parallel for schedule(dynamic) num_threads( \
     std::max(1, options.num_threads > 0 ? options.num_threads : num_cameras))
   for (int c = 0; c < num_cameras; ++c) {
     if (!calibration->camera_calibrated[c]) continue;
     inputs[c] = GatherUpgradeInput(dataset, *calibration, c);
-    success[c] =
-        UpgradeCamera(options.upgrade, inputs[c].points2D, inputs[c].points_cam,
-                      &calibration->cameras[c], &results[c]);
+    success[c] = UpgradeOrChooseCameraModel(
+        options, dataset, c, inputs[c].points2D, inputs[c].points_cam,
+        inputs[c].rows, &calibration->cameras[c], &results[c], &choices[c]);
   }
   for (int c = 0; c < num_cameras; ++c) {
     if (!calibration->camera_calibrated[c]) continue;
+    ReportModelChoice(options, dataset, c, choices[c], report);
     if (success[c]) {
       ApplyUpgrade(dataset, c, inputs[c], results[c], calibration);
     } else {

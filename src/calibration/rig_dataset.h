@@ -38,6 +38,10 @@ struct RigCamera {
   std::string name;  // the folder, e.g. "cam0"
   colmap::Camera camera;
   bool intrinsics_known = false;
+  // The model is chosen by the pipeline among candidates
+  // (--RigCalibrator.camera_model auto; model_selection.h): `camera`'s model
+  // is a placeholder then.
+  bool choose_model = false;
 };
 
 // One observation of a map point by a map image: the keypoint and its index

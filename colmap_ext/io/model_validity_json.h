@@ -1,0 +1,28 @@
+// The "validity" and "model_choice" entries of a camera in
+// calibration_summary.json (CameraModelReport, src/calibration/
+// camera_model_report.h):
+//   "validity": {"valid", "monotonic", "max_roundtrip_error_px" (null if not
+//     finite), "fold_radius_px" (null: no fold), "fold_angle_deg",
+//     "corner_radius_px", "suggested_model" (null: none), "message"}
+//   "model_choice" (cameras whose model was "auto" only): {"chosen",
+//     "reason", "candidates": [{"model", "valid", "heldout_rms_px",
+//     "train_rms_px", "num_params", "num_inliers", "chosen", "note"}]}
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "colmap_ext/io/calibration_summary.h"
+#include "src/calibration/pipeline_report.h"
+
+namespace rig_calibrator {
+
+// Copies the pipeline's per-camera model reports into the summary.
+void AttachCameraModelReports(const PipelineReport& report,
+                              CalibrationSummary* summary);
+
+// Adds the camera's "validity" (when checked) and "model_choice" (when
+// chosen) to its JSON node.
+void AddCameraModelJson(const CameraModelReport& report,
+                        nlohmann::ordered_json* node);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,117 @@
+#include "src/calibration/camera_model_stage.h"
+
+#include <algorithm>
+#include <iostream>
+
+namespace rig_calibrator {
+namespace {
+
+CameraModelReport& CameraModelReportOf(const RigDataset& dataset,
+                                       int camera_index,
+                                       PipelineReport* report) {
+  report->camera_models.resize(dataset.cameras.size());
+  return report->camera_models[camera_index];
+}
+
+}  // namespace
+
+bool UpgradeOrChooseCameraModel(
+    const PipelineOptions& options, const RigDataset& dataset,
+    const int camera_index, const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam,
+    const std::vector<std::pair<int, int>>& rows, colmap::Camera* camera,
+    CameraUpgradeResult* result, std::optional<ModelChoice>* choice) {
+  choice->reset();
+  if (!dataset.cameras[camera_index].choose_model) {
+    return UpgradeCamera(options.upgrade, points2D, points_cam, camera, result);
+  }
+  std::vector<int> groups;
+  groups.reserve(rows.size());
+  for (const auto& [image, correspondence] : rows) {
+    groups.push_back(dataset.images[image].frameset_index);
+  }
+  ModelChoice model_choice;
+  const bool success =
+      SelectCameraModel(options.model_selection, options.upgrade, points2D,
+                        points_cam, groups, camera, result, &model_choice);
+  *choice = model_choice;
+  return success;
+}
+
+void ReportModelChoice(const PipelineOptions& options,
+                       const RigDataset& dataset, const int camera_index,
+                       const std::optional<ModelChoice>& choice,
+                       PipelineReport* report) {
+  if (!choice) return;
+  CameraModelReportOf(dataset, camera_index, report).choice = *choice;
+  if (options.print_progress) {
+    std::cout << "  " << dataset.cameras[camera_index].name
+              << ": automatic model choice\n"
+              << FormatModelChoice(*choice, "    ") << std::flush;
+  }
+}
+
+void ChooseCameraModelsFromPoses(const PipelineOptions& options,
+                                 const RigDataset& dataset,
+                                 RigCalibration* calibration,
+                                 PipelineReport* report) {
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    if (!dataset.cameras[c].choose_model ||
+        !calibration->camera_calibrated[c]) {
+      continue;
+    }
+    std::vector<Eigen::Vector2d> points2D;
+    std::vector<Eigen::Vector3d> points_cam;
+    std::vector<std::pair<int, int>> rows;
+    for (size_t i = 0; i < dataset.images.size(); ++i) {
+      const RigImage& image = dataset.images[i];
+      if (image.camera_index != static_cast<int>(c) ||
+          !calibration->rig_from_world[image.frameset_index]) {
+        continue;
+      }
+      const Rigid3d cam_from_world =
+          calibration->CamFromWorld(image.camera_index, image.frameset_index);
+      for (size_t k = 0; k < image.correspondences.size(); ++k) {
+        points2D.push_back(image.correspondences[k].point2D);
+        points_cam.push_back(cam_from_world * image.correspondences[k].point3D);
+        rows.emplace_back(static_cast<int>(i), static_cast<int>(k));
+      }
+    }
+    colmap::Camera camera = calibration->cameras[c];
+    CameraUpgradeResult result;
+    std::optional<ModelChoice> choice;
+    if (UpgradeOrChooseCameraModel(options, dataset, static_cast<int>(c),
+                                   points2D, points_cam, rows, &camera, &result,
+                                   &choice)) {
+      calibration->cameras[c] = camera;
+    } else {
+      calibration->camera_calibrated[c] = false;
+      AddDiagnostic(report, Diagnostic::Level::kWarning, "upgrade_failed",
+                    "no camera model could be chosen for camera " +
+                        dataset.cameras[c].name + ": " + result.error_message,
+                    {static_cast<int>(c)});
+    }
+    ReportModelChoice(options, dataset, static_cast<int>(c), choice, report);
+  }
+}
+
+void CheckCameraModels(const PipelineOptions& options,
+                       const RigDataset& dataset,
+                       const RigCalibration& calibration,
+                       PipelineReport* report) {
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    if (!calibration.camera_calibrated[c]) continue;
+    const ModelValidity validity = CheckModelValidity(
+        calibration.cameras[c], options.model_selection.validity);
+    CameraModelReportOf(dataset, static_cast<int>(c), report).validity =
+        validity;
+    if (!validity.valid) {
+      AddDiagnostic(
+          report, Diagnostic::Level::kError, "invalid_camera_model",
+          "camera " + dataset.cameras[c].name + ": " + validity.message,
+          {static_cast<int>(c)});
+    }
+  }
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,54 @@
+// The pipeline's steps about camera models (pipeline.h): the automatic
+// choice of a camera's model where it was "auto" (RigCamera::choose_model;
+// model_selection.h), in the camera upgrade of 1dr and, for the full-pose
+// methods, after the rig initialization; and the validity check of every
+// calibrated camera's final model (model_validity.h), an error diagnostic
+// "invalid_camera_model" for a model that is not valid over the whole image.
+#pragma once
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "src/calibration/camera_model_report.h"
+#include "src/calibration/pipeline.h"
+
+namespace rig_calibrator {
+
+// The camera upgrade of one camera (UpgradeCamera) or, when its model is to
+// be chosen, SelectCameraModel over the same rows; `rows` gives the
+// (image, correspondence) of every row, whose frameset are the folds.
+bool UpgradeOrChooseCameraModel(const PipelineOptions& options,
+                                const RigDataset& dataset, int camera_index,
+                                const std::vector<Eigen::Vector2d>& points2D,
+                                const std::vector<Eigen::Vector3d>& points_cam,
+                                const std::vector<std::pair<int, int>>& rows,
+                                colmap::Camera* camera,
+                                CameraUpgradeResult* result,
+                                std::optional<ModelChoice>* choice);
+
+// Stores the choice in the report and prints the candidates' table.
+void ReportModelChoice(const PipelineOptions& options,
+                       const RigDataset& dataset, int camera_index,
+                       const std::optional<ModelChoice>& choice,
+                       PipelineReport* report);
+
+// The full-pose methods: for every calibrated camera whose model is to be
+// chosen, the candidates fitted to all its correspondences of posed
+// framesets with the poses of the rig initialization (the forward offset
+// that each fit estimates is left to the final bundle adjustment). A camera
+// for which no candidate works is left uncalibrated.
+void ChooseCameraModelsFromPoses(const PipelineOptions& options,
+                                 const RigDataset& dataset,
+                                 RigCalibration* calibration,
+                                 PipelineReport* report);
+
+// The validity of every calibrated camera's model, into
+// report->camera_models; an error diagnostic per invalid model (the camera
+// stays calibrated and is written: the command exits non-zero).
+void CheckCameraModels(const PipelineOptions& options,
+                       const RigDataset& dataset,
+                       const RigCalibration& calibration,
+                       PipelineReport* report);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,376 @@
+#include "src/calibration/model_selection.h"
+
+#include <ceres/ceres.h>
+#include <colmap/base/camera_models.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+namespace rig_calibrator {
+namespace {
+
+// Full reprojection residual of one row with the forward offset tz, as in
+// the camera upgrade: WorldToImage(params, x / (z + tz), y / (z + tz)) - x_obs.
+template <typename CameraModel>
+struct HeldOutResidual {
+  HeldOutResidual(const Eigen::Vector2d& point2D,
+                  const Eigen::Vector3d& point_cam)
+      : point2D(point2D), point_cam(point_cam) {}
+
+  template <typename T>
+  bool operator()(const T* const tz, const T* const params,
+                  T* residuals) const {
+    const T depth = T(point_cam.z()) + tz[0];
+    if (!(depth > T(0))) return false;
+    T x, y;
+    CameraModel::WorldToImage(params, T(point_cam.x()) / depth,
+                              T(point_cam.y()) / depth, &x, &y);
+    residuals[0] = x - T(point2D.x());
+    residuals[1] = y - T(point2D.y());
+    return true;
+  }
+
+  const Eigen::Vector2d point2D;
+  const Eigen::Vector3d point_cam;
+};
+
+// Squared reprojection error of a row truncated at max_error^2 (also for a
+// point behind the camera).
+double TruncatedSquaredError(const colmap::Camera& camera, double tz,
+                             const Eigen::Vector2d& point2D,
+                             const Eigen::Vector3d& point_cam,
+                             double max_error) {
+  const double depth = point_cam.z() + tz;
+  const double max_squared_error = max_error * max_error;
+  if (!(depth > 0)) return max_squared_error;
+  const Eigen::Vector2d projection = camera.WorldToImage(
+      Eigen::Vector2d(point_cam.x() / depth, point_cam.y() / depth));
+  const double squared_error = (projection - point2D).squaredNorm();
+  return std::isfinite(squared_error)
+             ? std::min(squared_error, max_squared_error)
+             : max_squared_error;
+}
+
+// LM over tz and the model's parameters (principal point held unless the
+// upgrade refines it) on `rows`, from the given values; false if the solve
+// is unusable (values unchanged).
+template <typename CameraModel>
+bool RefineOnRows(const CameraUpgradeOptions& upgrade_options,
+                  int max_num_iterations,
+                  const std::vector<Eigen::Vector2d>& points2D,
+                  const std::vector<Eigen::Vector3d>& points_cam,
+                  const std::vector<int>& rows, double* tz,
+                  std::vector<double>* params) {
+  double refined_tz = *tz;
+  std::vector<double> refined_params = *params;
+  ceres::Problem problem;
+  problem.AddParameterBlock(&refined_tz, 1);
+  problem.AddParameterBlock(refined_params.data(), CameraModel::kNumParams);
+  if (!upgrade_options.refine_principal_point) {
+    const std::vector<size_t>& idxs = CameraModel::principal_point_idxs;
+    problem.SetManifold(
+        refined_params.data(),
+        new ceres::SubsetManifold(CameraModel::kNumParams,
+                                  std::vector<int>(idxs.begin(), idxs.end())));
+  }
+  ceres::LossFunction* loss =
+      new ceres::CauchyLoss(upgrade_options.loss_scale_px);
+  for (const int row : rows) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<HeldOutResidual<CameraModel>, 2, 1,
+                                        CameraModel::kNumParams>(
+            new HeldOutResidual<CameraModel>(points2D[row], points_cam[row])),
+        loss, &refined_tz, refined_params.data());
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = max_num_iterations;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable() || !std::isfinite(refined_tz) ||
+      !std::all_of(refined_params.begin(), refined_params.end(),
+                   [](double p) { return std::isfinite(p); })) {
+    return false;
+  }
+  *tz = refined_tz;
+  *params = refined_params;
+  return true;
+}
+
+bool RefineOnRowsForModel(int model_id,
+                          const CameraUpgradeOptions& upgrade_options,
+                          int max_num_iterations,
+                          const std::vector<Eigen::Vector2d>& points2D,
+                          const std::vector<Eigen::Vector3d>& points_cam,
+                          const std::vector<int>& rows, double* tz,
+                          std::vector<double>* params) {
+  switch (model_id) {
+#define CAMERA_MODEL_CASE(CameraModel)                                     \
+  case colmap::CameraModel::kModelId:                                      \
+    return RefineOnRows<colmap::CameraModel>(upgrade_options,              \
+                                             max_num_iterations, points2D, \
+                                             points_cam, rows, tz, params);
+    CAMERA_MODEL_CASES
+#undef CAMERA_MODEL_CASE
+    default:
+      return false;
+  }
+}
+
+// A candidate's full fit.
+struct CandidateFit {
+  colmap::Camera camera;
+  CameraUpgradeResult result;
+  ModelValidity validity;
+};
+
+// The rows the held-out evaluation uses: the valid ones, at most
+// max_num_rows of them drawn with a fixed seed, in increasing order.
+std::vector<int> EvaluationSubset(
+    const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam, int max_num_rows) {
+  std::vector<int> rows;
+  for (size_t i = 0; i < points2D.size(); ++i) {
+    if (points2D[i].allFinite() && points_cam[i].allFinite()) {
+      rows.push_back(static_cast<int>(i));
+    }
+  }
+  if (rows.size() > static_cast<size_t>(max_num_rows)) {
+    std::mt19937 generator(0);
+    std::shuffle(rows.begin(), rows.end(), generator);
+    rows.resize(max_num_rows);
+    std::sort(rows.begin(), rows.end());
+  }
+  return rows;
+}
+
+// Per evaluation row, the candidate's truncated squared held-out error.
+std::vector<double> HeldOutSquaredErrors(
+    const ModelSelectionOptions& options,
+    const CameraUpgradeOptions& upgrade_options, const CandidateFit& fit,
+    const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam,
+    const std::vector<int>& groups, const std::vector<int>& subset,
+    const std::vector<int>& evaluation_rows) {
+  const int num_folds = std::max(2, options.num_folds);
+  std::vector<double> squared_errors(evaluation_rows.size(), 0);
+  for (int fold = 0; fold < num_folds; ++fold) {
+    std::vector<int> training;
+    for (const int row : subset) {
+      if (fit.result.inlier_mask[row] && groups[row] % num_folds != fold) {
+        training.push_back(row);
+      }
+    }
+    double tz = fit.result.tz;
+    std::vector<double> params = fit.camera.Params();
+    if (static_cast<int>(training.size()) > fit.camera.NumParams() + 1) {
+      RefineOnRowsForModel(fit.camera.ModelId(), upgrade_options,
+                           options.max_num_fold_iterations, points2D,
+                           points_cam, training, &tz, &params);
+    }
+    colmap::Camera fold_camera = fit.camera;
+    fold_camera.SetParams(params);
+    for (size_t e = 0; e < evaluation_rows.size(); ++e) {
+      const int row = evaluation_rows[e];
+      if (groups[row] % num_folds != fold) continue;
+      squared_errors[e] =
+          TruncatedSquaredError(fold_camera, tz, points2D[row], points_cam[row],
+                                upgrade_options.max_error_px);
+    }
+  }
+  return squared_errors;
+}
+
+double Mean(const std::vector<double>& values) {
+  return values.empty() ? 0
+                        : std::accumulate(values.begin(), values.end(), 0.0) /
+                              values.size();
+}
+
+std::string Fixed(double value, int precision) {
+  std::ostringstream stream;
+  stream << std::fixed << std::setprecision(precision) << value;
+  return stream.str();
+}
+
+}  // namespace
+
+bool SelectCameraModel(const ModelSelectionOptions& options,
+                       const CameraUpgradeOptions& upgrade_options,
+                       const std::vector<Eigen::Vector2d>& points2D,
+                       const std::vector<Eigen::Vector3d>& points_cam,
+                       const std::vector<int>& groups, colmap::Camera* camera,
+                       CameraUpgradeResult* result, ModelChoice* choice) {
+  *choice = ModelChoice();
+  *result = CameraUpgradeResult();
+  if (groups.size() != points2D.size() ||
+      points_cam.size() != points2D.size()) {
+    result->error_message = "one frameset per correspondence needed";
+    choice->reason = result->error_message;
+    return false;
+  }
+  std::vector<CandidateFit> fits;
+  for (const std::string& model : options.candidate_models) {
+    ModelCandidate candidate;
+    candidate.model = model;
+    CandidateFit fit;
+    if (!colmap::ExistsCameraModelWithName(model)) {
+      candidate.note = "not a COLMAP model";
+      choice->candidates.push_back(candidate);
+      fits.push_back(fit);
+      continue;
+    }
+    fit.camera.InitializeWithName(model, camera->MeanFocalLength(),
+                                  camera->Width(), camera->Height());
+    fit.camera.SetPrincipalPointX(camera->PrincipalPointX());
+    fit.camera.SetPrincipalPointY(camera->PrincipalPointY());
+    candidate.num_params = static_cast<int>(fit.camera.NumParams());
+    candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
+                                     &fit.camera, &fit.result);
+    if (!candidate.fitted) {
+      candidate.note = "no fit: " + fit.result.error_message;
+    } else {
+      candidate.num_inliers = fit.result.num_inliers;
+      candidate.train_rms_px = fit.result.rms_px;
+      fit.validity = CheckModelValidity(fit.camera, options.validity);
+      candidate.valid = fit.validity.valid;
+      if (!candidate.valid) candidate.note = "invalid: " + fit.validity.message;
+    }
+    choice->candidates.push_back(candidate);
+    fits.push_back(fit);
+  }
+
+  const std::vector<int> subset =
+      EvaluationSubset(points2D, points_cam, options.max_num_rows);
+  std::vector<int> evaluation_rows;
+  for (const int row : subset) {
+    for (size_t m = 0; m < fits.size(); ++m) {
+      if (choice->candidates[m].valid && fits[m].result.inlier_mask[row]) {
+        evaluation_rows.push_back(row);
+        break;
+      }
+    }
+  }
+  if (evaluation_rows.empty()) {
+    result->error_message =
+        "none of the candidate models (" +
+        std::to_string(options.candidate_models.size()) +
+        ") could be fitted and is valid over the whole image";
+    choice->reason = result->error_message;
+    return false;
+  }
+
+  std::vector<std::vector<double>> squared_errors(fits.size());
+  int best = -1;
+  for (size_t m = 0; m < fits.size(); ++m) {
+    if (!choice->candidates[m].valid) continue;
+    squared_errors[m] =
+        HeldOutSquaredErrors(options, upgrade_options, fits[m], points2D,
+                             points_cam, groups, subset, evaluation_rows);
+    const double mse = Mean(squared_errors[m]);
+    choice->candidates[m].heldout_rms_px = std::sqrt(mse);
+    if (best < 0 || mse < Mean(squared_errors[best]))
+      best = static_cast<int>(m);
+  }
+
+  // The one-standard-error rule over the paired differences to the best.
+  const double n = evaluation_rows.size();
+  int chosen = best;
+  std::vector<double> mean_difference(fits.size(), 0);
+  std::vector<double> standard_error(fits.size(), 0);
+  for (size_t m = 0; m < fits.size(); ++m) {
+    if (!choice->candidates[m].valid) continue;
+    double sum = 0, sum_squares = 0;
+    for (size_t e = 0; e < evaluation_rows.size(); ++e) {
+      const double d = squared_errors[m][e] - squared_errors[best][e];
+      sum += d;
+      sum_squares += d * d;
+    }
+    mean_difference[m] = sum / n;
+    const double variance =
+        n > 1 ? std::max(0.0, (sum_squares - sum * sum / n) / (n - 1)) : 0;
+    standard_error[m] = std::sqrt(variance / n);
+    const bool as_good =
+        mean_difference[m] <=
+        options.significance * standard_error[m] + kMinMseDifference;
+    ModelCandidate& candidate = choice->candidates[m];
+    if (static_cast<int>(m) != best) {
+      candidate.note = std::string(as_good ? "as good as" : "worse than") +
+                       " the best (mean squared error +" +
+                       Fixed(mean_difference[m], 5) + " px^2, standard error " +
+                       Fixed(standard_error[m], 5) + ")";
+    }
+    const ModelCandidate& current = choice->candidates[chosen];
+    if (as_good && (candidate.num_params < current.num_params ||
+                    (candidate.num_params == current.num_params &&
+                     candidate.heldout_rms_px < current.heldout_rms_px))) {
+      chosen = static_cast<int>(m);
+    }
+  }
+  if (chosen == best) {
+    choice->candidates[best].note = "lowest held-out error";
+  }
+  ModelCandidate& winner = choice->candidates[chosen];
+  winner.chosen = true;
+  choice->chosen = winner.model;
+  const ModelCandidate& best_candidate = choice->candidates[best];
+  const int num_folds = std::max(2, options.num_folds);
+  if (chosen == best) {
+    choice->reason = winner.model + " has the lowest held-out error (" +
+                     Fixed(winner.heldout_rms_px, 3) + " px over " +
+                     std::to_string(evaluation_rows.size()) +
+                     " correspondences, " + std::to_string(num_folds) +
+                     "-fold over framesets) and no model with fewer "
+                     "parameters is as good";
+  } else {
+    choice->reason =
+        winner.model + " (" + std::to_string(winner.num_params) +
+        " parameters, held-out " + Fixed(winner.heldout_rms_px, 3) +
+        " px) is within " + Fixed(options.significance, 1) +
+        " standard errors of the best, " + best_candidate.model + " (" +
+        std::to_string(best_candidate.num_params) + " parameters, " +
+        Fixed(best_candidate.heldout_rms_px, 3) + " px), with fewer parameters";
+  }
+  int num_invalid = 0;
+  for (const ModelCandidate& candidate : choice->candidates) {
+    if (candidate.fitted && !candidate.valid) ++num_invalid;
+  }
+  if (num_invalid > 0) {
+    choice->reason += "; " + std::to_string(num_invalid) +
+                      " fitted candidate(s) were not valid over the whole "
+                      "image and were dropped";
+  }
+  *camera = fits[chosen].camera;
+  *result = fits[chosen].result;
+  return true;
+}
+
+std::string FormatModelChoice(const ModelChoice& choice,
+                              const std::string& indent) {
+  std::ostringstream out;
+  out << indent << std::left << std::setw(22) << "candidate" << std::right
+      << std::setw(7) << "params" << std::setw(9) << "inliers" << std::setw(11)
+      << "train px" << std::setw(13) << "held-out px"
+      << "  \n";
+  for (const ModelCandidate& candidate : choice.candidates) {
+    out << indent << (candidate.chosen ? "* " : "  ") << std::left
+        << std::setw(20) << candidate.model << std::right << std::setw(7)
+        << candidate.num_params << std::setw(9) << candidate.num_inliers
+        << std::setw(11)
+        << (candidate.fitted ? Fixed(candidate.train_rms_px, 3) : "-")
+        << std::setw(13)
+        << (candidate.valid ? Fixed(candidate.heldout_rms_px, 3) : "-") << "  "
+        << candidate.note << "\n";
+  }
+  out << indent
+      << "chosen: " << (choice.chosen.empty() ? "none" : choice.chosen) << ": "
+      << choice.reason << "\n";
+  return out.str();
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,101 @@
+// Automatic choice of a camera's COLMAP model (--RigCalibrator.camera_model
+// auto): every candidate model is fitted by the camera upgrade
+// (camera_upgrader.h) to the same correspondences, candidates that are not
+// valid over the whole image (model_validity.h) are dropped, and the others
+// are compared by their held-out reprojection error.
+//
+// Held-out error: the framesets are split into K folds (frameset index mod
+// K). For fold k, tz and the model's parameters are refined from the
+// candidate's full fit on its inliers outside fold k (Levenberg-Marquardt,
+// the upgrade's Cauchy loss, the poses held), and every evaluation row in
+// fold k is predicted. The evaluation rows are the union of the valid
+// candidates' inliers, the same for all candidates, so that a model cannot
+// look good by rejecting what it cannot fit; a row's squared error is
+// truncated at the upgrade's inlier threshold T, e^2 = min(|r|^2, T^2), so
+// that the few wrong correspondences that some candidate accepted do not
+// dominate. heldout_rms = sqrt(mean e^2).
+//
+// Choice (the "one standard error" rule of cross-validation): with b the
+// candidate of least held-out error and, per row, d_i = e_m,i^2 - e_b,i^2,
+// a candidate m is as good as b when mean(d) <= z SE(d) + kMinMseDifference
+// (SE = standard deviation / sqrt(n), z = `significance`); of those, the one
+// with the fewest parameters wins (ties: the lower held-out error). More
+// parameters must earn their place by predicting unseen framesets better.
+//
+// Candidates (ModelSelectionOptions::candidate_models), why these:
+// SIMPLE_RADIAL, RADIAL, OPENCV cover pinhole-type lenses with no, radial
+// or radial-tangential distortion; SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE and
+// OPENCV_FISHEYE the same for angle-based (fisheye) lenses, which are the
+// only ones that can represent fields of view near or beyond 120 degrees.
+// Not by default: SIMPLE_PINHOLE / PINHOLE (a real lens has some
+// distortion, SIMPLE_RADIAL costs one parameter more), FULL_OPENCV (its
+// rational terms fit the data region and fold outside it easily),
+// THIN_PRISM_FISHEYE (12 parameters for decentred lenses: give it by hand).
+#pragma once
+
+#include <colmap/base/camera.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "src/calibration/camera_upgrader.h"
+#include "src/evaluation/model_validity.h"
+
+namespace rig_calibrator {
+
+// The --RigCalibrator.camera_model value that asks for the choice.
+inline constexpr char kAutoCameraModel[] = "auto";
+
+// Differences of mean squared held-out error below this (px^2, i.e. 0.01 px
+// of RMS on exact data) carry no information.
+constexpr double kMinMseDifference = 1e-4;
+
+struct ModelSelectionOptions {
+  std::vector<std::string> candidate_models = {
+      "SIMPLE_RADIAL",         "RADIAL",         "OPENCV",
+      "SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE", "OPENCV_FISHEYE"};
+  int num_folds = 5;
+  double significance = 2.0;  // z of the choice rule
+  // The held-out evaluation uses at most this many rows (a fixed random
+  // subset): its statistics need a few thousand, not 1e5.
+  int max_num_rows = 10000;
+  int max_num_fold_iterations = 50;
+  ModelValidityOptions validity;
+};
+
+struct ModelCandidate {
+  std::string model;
+  int num_params = 0;
+  bool fitted = false;  // the upgrade found a consistent model
+  bool valid = false;   // fitted and valid over the whole image
+  int num_inliers = 0;
+  double train_rms_px = 0;    // over its inliers, the full fit
+  double heldout_rms_px = 0;  // 0 unless valid
+  bool chosen = false;
+  std::string note;  // why dropped, or how it compares with the best
+};
+
+struct ModelChoice {
+  std::string chosen;  // empty when no candidate could be used
+  std::string reason;
+  std::vector<ModelCandidate> candidates;
+};
+
+// points2D, points_cam: as for UpgradeCamera; groups: the frameset of every
+// row (the cross-validation folds). camera: in: width, height, principal
+// point; out: the chosen model and its parameters. result: the chosen
+// model's upgrade. Returns false (camera unchanged) when no candidate is
+// valid, with result->error_message and choice->reason saying why.
+bool SelectCameraModel(const ModelSelectionOptions& options,
+                       const CameraUpgradeOptions& upgrade_options,
+                       const std::vector<Eigen::Vector2d>& points2D,
+                       const std::vector<Eigen::Vector3d>& points_cam,
+                       const std::vector<int>& groups, colmap::Camera* camera,
+                       CameraUpgradeResult* result, ModelChoice* choice);
+
+// The candidates' table (one line each) and the reason, for the terminal.
+std::string FormatModelChoice(const ModelChoice& choice,
+                              const std::string& indent);
+
+}  // namespace rig_calibrator
