@@ -74,6 +74,8 @@ std::vector<ModelRigImage> FindRigImages(
 
 // The observed points and their residuals (observed - projected) of one
 // image: of its observations of 3D points, or of its correspondence rows.
+constexpr double kMinInlierThresholdPx = 0.01;
+
 struct Observation {
   Eigen::Vector2d point, residual;
 };
@@ -150,7 +152,8 @@ ModelResiduals ComputeModelResiduals(
                    });
 
   // Cameras without observations of 3D points take their correspondence
-  // rows, within 3 x the median residual of the camera's rows.
+  // rows, within 3 x the median residual of the camera's rows (at least
+  // kMinInlierThresholdPx, for exact data).
   std::unordered_map<std::string, const ImageCorrespondences*> rows_of_image;
   for (const ImageCorrespondences& rows : correspondences) {
     rows_of_image[rows.image_name] = &rows;
@@ -186,7 +189,8 @@ ModelResiduals ComputeModelResiduals(
     std::nth_element(errors.begin(), errors.begin() + errors.size() / 2,
                      errors.end());
     residuals.cameras[c].from_correspondences = true;
-    residuals.cameras[c].inlier_threshold_px = 3 * errors[errors.size() / 2];
+    residuals.cameras[c].inlier_threshold_px =
+        std::max(3 * errors[errors.size() / 2], kMinInlierThresholdPx);
   }
 
   // Sums of squared residuals: rms = sqrt(sum / n).

@@ -36,8 +36,8 @@ struct CameraResiduals {
   // points (the inliers), or, for a camera with none (a calibration from a
   // correspondence file without a map has no 3D points), the rows of
   // correspondences.txt within `inlier_threshold_px` = 3 x the median
-  // residual of the camera's rows (for Gaussian noise the median of |r| is
-  // 1.18 sigma, so this keeps 99.8 % of the inliers).
+  // residual of the camera's rows, at least 0.01 px (for Gaussian noise the
+  // median of |r| is 1.18 sigma, so this keeps 99.8 % of the inliers).
   bool from_correspondences = false;
   double inlier_threshold_px = 0;
   int width = 0, height = 0;
