@@ -43,7 +43,8 @@ inline std::string TextAt(const ReportJson& node, const char* key) {
 inline std::string FormatNumber(const double value, const int digits = 4) {
   if (!std::isfinite(value)) return "\u2013";
   char text[40];
-  std::snprintf(text, sizeof(text), "%.*g", digits, value);
+  // + 0.0: -0 (e.g. the reference camera's centre) is shown as 0.
+  std::snprintf(text, sizeof(text), "%.*g", digits, value + 0.0);
   return text;
 }
 

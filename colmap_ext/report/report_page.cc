@@ -42,7 +42,7 @@ figcaption { font-size: 0.8em; color: #444; max-width: 560px; }
 .why { color: #666; font-size: 0.9em; }
 .error { color: #b00020; } .warning { color: #8a5a00; } .info, .note { color: #333; }
 tr.bad td, .bad { background: #fde0e0; }
-tr.chosen td { background: #e3f4e3; }
+.chosen { background: #e3f4e3; }
 pre { background: #f7f7f7; padding: 0.6em; overflow-x: auto; font-size: 0.8em; }
 nav a { margin-right: 1em; }
 )";

@@ -104,8 +104,9 @@ std::optional<Eigen::Vector3d> CamFromRigTranslation(const ReportJson& camera) {
 std::string IntrinsicsTableHtml(const ReportJson& summary) {
   std::ostringstream html;
   html << "<table id=\"intrinsics-table\"><tr><th>camera</th><th>model</th>"
-          "<th>image</th><th>parameter</th><th>value \u00b1 1\u03c3 (px; "
-          "distortion unitless)</th><th>refined</th></tr>\n";
+          "<th>image</th><th>focal length (px) \u00b1 1\u03c3</th>"
+          "<th>principal point (px) \u00b1 1\u03c3</th><th>distortion "
+          "\u00b1 1\u03c3</th><th>refined</th></tr>\n";
   for (const ReportJson& camera : Cameras(summary)) {
     const std::string model = TextAt(camera, "model");
     const ReportJson* params = FindKey(camera, "params");
@@ -116,6 +117,32 @@ std::string IntrinsicsTableHtml(const ReportJson& summary) {
     const ReportJson* stddevs = uncertainty != nullptr
                                     ? FindKey(*uncertainty, "params_stddev")
                                     : nullptr;
+    // COLMAP's grouping of the model's parameters; all "distortion" for a
+    // model COLMAP 3.8 does not know.
+    std::vector<int> group(count, 2);
+    if (colmap::ExistsCameraModelWithName(model)) {
+      const int model_id = colmap::CameraModelNameToId(model);
+      for (const size_t k : colmap::CameraModelFocalLengthIdxs(model_id)) {
+        if (k < count) group[k] = 0;
+      }
+      for (const size_t k : colmap::CameraModelPrincipalPointIdxs(model_id)) {
+        if (k < count) group[k] = 1;
+      }
+    }
+    std::string cells[3];
+    for (size_t k = 0; k < count; ++k) {
+      const double stddev =
+          stddevs != nullptr && stddevs->is_array() && k < stddevs->size()
+              ? NumberOr(&(*stddevs)[k])
+              : std::nan("");
+      std::string& cell = cells[group[k]];
+      if (!cell.empty()) cell += "<br/>";
+      cell +=
+          Escape(names[k]) + " " + WithStddev(NumberOr(&(*params)[k]), stddev);
+    }
+    if (stddevs == nullptr) {
+      cells[0] += "<br/>\u03c3: " + NotComputedHtml("no \"uncertainty\"");
+    }
     const ReportJson* refined = FindKey(camera, "refined");
     std::string refined_html = NotComputedHtml("no \"refined\" in the summary");
     if (refined != nullptr) {
@@ -123,39 +150,20 @@ std::string IntrinsicsTableHtml(const ReportJson& summary) {
       for (const char* key :
            {"focal_length", "principal_point", "extra_params"}) {
         const ReportJson* flag = FindKey(*refined, key);
+        if (!refined_html.empty()) refined_html += "<br/>";
         refined_html += std::string(key) + ": " +
                         (flag != nullptr && flag->is_boolean()
                              ? (flag->get<bool>() ? "yes" : "no (held)")
-                             : "\u2013") +
-                        "<br/>";
+                             : "\u2013");
       }
     }
-    const size_t rows = std::max<size_t>(1, count);
-    html << "<tr><td rowspan=\"" << rows << "\">"
-         << Escape(TextAt(camera, "name")) << "</td><td rowspan=\"" << rows
-         << "\">" << Escape(model) << "</td><td rowspan=\"" << rows << "\">"
-         << FormatNumber(NumberAt(camera, "width"), 6) << " \u00d7 "
-         << FormatNumber(NumberAt(camera, "height"), 6) << "</td>";
-    for (size_t k = 0; k < rows; ++k) {
-      if (k > 0) html << "<tr>";
-      if (count == 0) {
-        html << "<td>\u2013</td><td>\u2013</td>";
-      } else {
-        const double stddev =
-            stddevs != nullptr && stddevs->is_array() && k < stddevs->size()
-                ? NumberOr(&(*stddevs)[k])
-                : std::nan("");
-        html << Cell(Escape(names[k]))
-             << Cell(WithStddev(NumberOr(&(*params)[k]), stddev) +
-                     (stddevs == nullptr && k == 0
-                          ? " " + NotComputedHtml("no \"uncertainty\"")
-                          : std::string()));
-      }
-      if (k == 0) {
-        html << "<td rowspan=\"" << rows << "\">" << refined_html << "</td>";
-      }
-      html << "</tr>\n";
-    }
+    html << "<tr>" << Cell(Escape(TextAt(camera, "name")))
+         << Cell(Escape(model))
+         << Cell(FormatNumber(NumberAt(camera, "width"), 6) + " \u00d7 " +
+                 FormatNumber(NumberAt(camera, "height"), 6))
+         << Cell(cells[0]) << Cell(cells[1])
+         << Cell(cells[2].empty() ? "none" : cells[2]) << Cell(refined_html)
+         << "</tr>\n";
   }
   html << "</table>\n";
   return html.str();
@@ -207,46 +215,52 @@ std::string PosesTableHtml(const ReportJson& summary) {
 }
 
 std::string ModelChoiceHtml(const ReportJson& summary) {
-  std::ostringstream html;
-  int num_tables = 0;
+  std::ostringstream rows;
+  int num_cameras = 0;
   for (const ReportJson& camera : Cameras(summary)) {
     const ReportJson* choice = FindKey(camera, "model_choice");
     if (choice == nullptr) continue;
-    ++num_tables;
-    html << "<h3>" << Escape(TextAt(camera, "name")) << ": "
-         << Escape(TextAt(*choice, "chosen")) << "</h3><p>"
-         << Escape(TextAt(*choice, "reason")) << "</p>\n"
-         << "<table class=\"model-choice-table\"><tr><th>model</th>"
-            "<th>valid</th><th>held-out RMS (px)</th><th>training RMS (px)</th>"
-            "<th>parameters</th><th>chosen</th></tr>\n";
+    ++num_cameras;
     const ReportJson* candidates = FindKey(*choice, "candidates");
-    if (candidates != nullptr && candidates->is_array()) {
-      for (const ReportJson& candidate : *candidates) {
-        const ReportJson* valid = FindKey(candidate, "valid");
-        const ReportJson* chosen = FindKey(candidate, "chosen");
-        const bool is_chosen =
-            chosen != nullptr && chosen->is_boolean() && chosen->get<bool>();
-        html << (is_chosen ? "<tr class=\"chosen\">" : "<tr>")
-             << Cell(Escape(TextAt(candidate, "model")))
-             << Cell(valid != nullptr && valid->is_boolean()
-                         ? (valid->get<bool>() ? "yes" : "no")
-                         : "\u2013")
-             << Cell(FormatNumber(NumberAt(candidate, "heldout_rms_px")))
-             << Cell(FormatNumber(NumberAt(candidate, "train_rms_px")))
-             << Cell(FormatNumber(NumberAt(candidate, "num_params")))
-             << Cell(is_chosen ? "\u2714" : "") << "</tr>\n";
-      }
+    const size_t count = candidates != nullptr && candidates->is_array()
+                             ? candidates->size()
+                             : 0;
+    const std::string span =
+        "<td rowspan=\"" + std::to_string(std::max<size_t>(1, count)) + "\">";
+    rows << "<tr>" << span << Escape(TextAt(camera, "name")) << "</td>" << span
+         << "<b>" << Escape(TextAt(*choice, "chosen"))
+         << "</b>: " << Escape(TextAt(*choice, "reason")) << "</td>";
+    if (count == 0) rows << "<td colspan=\"6\">no candidates</td></tr>\n";
+    for (size_t k = 0; k < count; ++k) {
+      const ReportJson& candidate = (*candidates)[k];
+      const ReportJson* valid = FindKey(candidate, "valid");
+      const ReportJson* chosen = FindKey(candidate, "chosen");
+      const bool is_chosen =
+          chosen != nullptr && chosen->is_boolean() && chosen->get<bool>();
+      if (k > 0) rows << "<tr>";
+      rows << Cell(std::string(is_chosen ? "<b class=\"chosen\">" : "") +
+                   Escape(TextAt(candidate, "model")) +
+                   (is_chosen ? " \u2714</b>" : ""))
+           << Cell(valid != nullptr && valid->is_boolean()
+                       ? (valid->get<bool>() ? "yes" : "no")
+                       : "\u2013")
+           << Cell(FormatNumber(NumberAt(candidate, "heldout_rms_px")))
+           << Cell(FormatNumber(NumberAt(candidate, "train_rms_px")))
+           << Cell(FormatNumber(NumberAt(candidate, "num_params")))
+           << "</tr>\n";
     }
-    html << "</table>\n";
   }
-  if (num_tables == 0) {
-    html << "<p>"
-         << NotComputedHtml(
-                "no camera has \"model_choice\": it is written for cameras "
-                "whose --RigCalibrator.camera_model is auto")
-         << "</p>\n";
+  if (num_cameras == 0) {
+    return "<p>" +
+           NotComputedHtml(
+               "no camera has \"model_choice\": it is written for cameras "
+               "whose --RigCalibrator.camera_model is auto") +
+           "</p>\n";
   }
-  return html.str();
+  return "<table id=\"model-choice-table\"><tr><th>camera</th><th>chosen, "
+         "and why</th><th>candidate</th><th>valid</th><th>held-out RMS "
+         "(px)</th><th>training RMS (px)</th><th>parameters</th></tr>\n" +
+         rows.str() + "</table>\n";
 }
 
 std::string ValidityTableHtml(const ReportJson& summary) {

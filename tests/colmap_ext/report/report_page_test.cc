@@ -216,9 +216,9 @@ TEST(ReportPage, TheContractKeysFillEverySection) {
   // switches, the pose sigmas, the model choice, the validity, the coverage
   // and projection numbers, the ellipses (4 mm at the rig's scale).
   for (const char* text :
-       {"<td>fx</td><td>300 \u00b1 0.19</td>", "principal_point: no (held)",
-        "\u00b1 0.012", "\u00b1 0.006",
-        "<tr class=\"chosen\"><td>OPENCV_FISHEYE", "lowest held-out RMS",
+       {"<td>fx 300 \u00b1 0.19<br/>fy 301 \u00b1 0.2</td>",
+        "principal_point: no (held)", "\u00b1 0.012", "\u00b1 0.006",
+        "<b class=\"chosen\">OPENCV_FISHEYE \u2714</b>", "lowest held-out RMS",
         "<b class=\"bad\">no</b>", "OPENCV_FISHEYE</td>",
         "the distortion folds back at 402 px",
         "From &quot;coverage&quot;: 75 %", "median 0.31 px, max 0.9 px",
@@ -227,7 +227,7 @@ TEST(ReportPage, TheContractKeysFillEverySection) {
         "a diagnostic &lt;with&gt; markup &amp; quotes &quot;"}) {
     EXPECT_NE(html.find(text), std::string::npos) << text;
   }
-  EXPECT_EQ(Count(html, "<tr class=\"chosen\">"), 3u);
+  EXPECT_EQ(Count(html, "<b class=\"chosen\">"), 3u);
 }
 
 TEST(ReportPage, IsWrittenInsideTheOutputAndRebuiltIdentically) {
