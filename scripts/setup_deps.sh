@@ -38,6 +38,9 @@ packages=(
   # scripts/fuzz.sh: clang (14 in bookworm), the runtimes of libFuzzer and
   # the sanitizers, and clang's OpenMP (COLMAP's headers need OpenMP).
   clang libclang-rt-14-dev libomp-14-dev
+  # The report's browser test (ctest -R report_browser): headless Chromium
+  # and a font for its text.
+  chromium fonts-dejavu-core
 )
 
 missing_packages() {

@@ -14,6 +14,7 @@
 #include "colmap_ext/io/database_export.h"
 #include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/model_writer.h"
+#include "colmap_ext/report/report_page.h"
 
 namespace rig_calibrator {
 namespace {
@@ -43,6 +44,7 @@ RigOutputOptions MakeOutputOptions(const CalibrateOptions& options,
         options.correspondences_path}) {
     if (!input.empty()) output_options.input_paths.push_back(input);
   }
+  output_options.finish_folder = &WriteReportHtml;
   return output_options;
 }
 
@@ -131,7 +133,7 @@ int RunCalibrate(int argc, char** argv) {
                "rig_config.json for COLMAP >= 3.12, "
                "rig_bundle_adjuster_config.json for COLMAP 3.8, camchain.yaml "
                "(Kalibr), calibration_summary.json, correspondences.txt, "
-               "timings.json."
+               "timings.json, report.html (open it in a browser)."
             << std::endl;
   if (report.HasErrors()) {
     return PrintError(

@@ -21,6 +21,9 @@ int RunSynthetic(int argc, char** argv);
 // The paper's short-sequence robustness experiment on synthetic rigs.
 int RunBenchmark(int argc, char** argv);
 
+// Rebuilds report.html in a calibration output folder (report_command.cc).
+int RunReport(int argc, char** argv);
+
 // Time and peak memory of the calibration core and of the localization
 // (runtime_benchmark_command.cc).
 int RunRuntimeBenchmark(int argc, char** argv);

@@ -26,6 +26,8 @@ Commands() {
           {"evaluate",
            {&RunEvaluate,
             "compare a calibration with a reference calibration"}},
+          {"report",
+           {&RunReport, "rebuild report.html in a calibration output folder"}},
           {"synthetic",
            {&RunSynthetic,
             "write a synthetic rig dataset with exact ground truth"}},

@@ -7,7 +7,7 @@
 
 namespace rig_calibrator {
 
-// Runs `PROGRAM [calibrate|evaluate|synthetic|render|benchmark|
+// Runs `PROGRAM [calibrate|evaluate|report|synthetic|render|benchmark|
 // benchmark_runtime] [options]` with argv[0] the program name: no argument,
 // `help` or `commands` lists the sub-commands, an option first goes to
 // `calibrate` (so `PROGRAM -h` shows the calibration options). `program` is

@@ -392,8 +392,8 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
   return ReadMap(path, map, &info, error);
 }
 
-bool ReadMap(const std::string& path, colmap::Reconstruction* map,
-             MapReadInfo* info, std::string* error) {
+bool ReadModel(const std::string& path, colmap::Reconstruction* map,
+               MapReadInfo* info, std::string* error) {
   *info = MapReadInfo();
   const fs::path folder(path);
   if (!fs::is_directory(folder)) {
@@ -435,6 +435,12 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
       !ReadMapRigsAndFrames(path, binary, *map, info, error)) {
     return false;
   }
+  return true;
+}
+
+bool ReadMap(const std::string& path, colmap::Reconstruction* map,
+             MapReadInfo* info, std::string* error) {
+  if (!ReadModel(path, map, info, error)) return false;
   if (map->NumRegImages() == 0) {
     *error = "the map in " + path + " has no registered image";
     return false;

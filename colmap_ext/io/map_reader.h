@@ -56,6 +56,11 @@ bool ReadMap(const std::string& path, colmap::Reconstruction* map,
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              std::string* error);
 
+// As ReadMap, but a model without registered images or 3D points is read
+// too (e.g. the output model of a calibration from correspondences alone).
+bool ReadModel(const std::string& path, colmap::Reconstruction* model,
+               MapReadInfo* info, std::string* error);
+
 // Rewrites the cameras file of the model written in `folder` (cameras.bin
 // if `binary`, else cameras.txt) with the real records of `cameras` in place
 // of their placeholders. No-op for an empty list.

@@ -522,7 +522,9 @@ bool WriteRigOutput(const std::string& output_path,
           output_path, folder_options,
           [&](const std::string& folder, std::string* write_error) {
             return WriteRigOutputFiles(folder, dataset, summary, &contents,
-                                       write_error);
+                                       write_error) &&
+                   (!options.finish_folder ||
+                    options.finish_folder(folder, write_error));
           },
           error)) {
     return false;

@@ -13,10 +13,14 @@
 //                                              file that changes between runs
 //                                              of the same input)
 //   correspondences.txt                        the 2D-3D correspondences used
+//   report.html                                the visual report, when the
+//                                              caller's finish_folder writes
+//                                              it (the calibrate command)
 #pragma once
 
 #include <colmap/base/reconstruction.h>
 
+#include <functional>
 #include <string>
 #include <unordered_set>
 #include <vector>
@@ -82,6 +86,11 @@ struct RigOutputOptions {
   // Map cameras of models COLMAP 3.8 does not know (MapReadInfo), written in
   // place of their placeholders.
   std::vector<CameraRecord> newer_model_map_cameras;
+  // Called last on the temporary folder holding every file above, e.g. to
+  // write report.html from them (colmap_ext/report/report_page.h, which
+  // depends on this library); its failure fails the whole output.
+  std::function<bool(const std::string& folder, std::string* error)>
+      finish_folder;
 };
 
 // Builds the model (BuildRigModel) and writes every file above into

@@ -52,8 +52,12 @@ std::string Number(double value) {
 }
 
 void Header(const PlotOptions& options, std::ostringstream* svg) {
-  *svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << options.width
+  if (options.inline_id.empty()) {
+    *svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg";
+  } else {
+    *svg << "<svg id=\"" << XmlEscape(options.inline_id) << "\"";
+  }
+  *svg << " xmlns=\"http://www.w3.org/2000/svg\" width=\"" << options.width
        << "\" height=\"" << options.height << "\" viewBox=\"0 0 "
        << options.width << " " << options.height
        << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
@@ -248,12 +252,15 @@ std::string LinePlotSvg(const PlotOptions& options,
         << "\" stroke=\"#555555\" stroke-dasharray=\"5,4\"/>\n";
     if (m < options.x_marker_labels.size()) {
       svg << "<text x=\"" << Number(axes.X(x) + 4) << "\" y=\""
-          << Number(axes.top + 14) << "\" fill=\"#555555\">"
+          << Number(axes.top + 14 * (m + 1)) << "\" fill=\"#555555\">"
           << XmlEscape(options.x_marker_labels[m]) << "</text>\n";
     }
   }
   // Data clipped to the plot area.
-  svg << "<clipPath id=\"plot-area\"><rect x=\"" << Number(axes.left)
+  const std::string clip_id = options.inline_id.empty()
+                                  ? std::string("plot-area")
+                                  : XmlEscape(options.inline_id) + "-plot-area";
+  svg << "<clipPath id=\"" << clip_id << "\"><rect x=\"" << Number(axes.left)
       << "\" y=\"" << Number(axes.top) << "\" width=\""
       << Number(axes.right - axes.left) << "\" height=\""
       << Number(axes.bottom - axes.top) << "\"/></clipPath>\n";
@@ -274,9 +281,9 @@ std::string LinePlotSvg(const PlotOptions& options,
       first = false;
     }
     if (first) continue;
-    svg << "<polyline clip-path=\"url(#plot-area)\" fill=\"none\" stroke=\""
-        << Color(s) << "\" stroke-width=\"2\" points=\"" << points.str()
-        << "\"/>\n";
+    svg << "<polyline clip-path=\"url(#" << clip_id
+        << ")\" fill=\"none\" stroke=\"" << Color(s)
+        << "\" stroke-width=\"2\" points=\"" << points.str() << "\"/>\n";
   }
   Legend(axes, labels, /*as_boxes=*/false, &svg);
   svg << "</svg>\n";

@@ -29,11 +29,17 @@ struct PlotOptions {
   double x_min = std::nan(""), x_max = std::nan("");
   double y_min = std::nan(""), y_max = std::nan("");
   // Optional vertical reference lines (e.g. a "good" threshold), drawn dashed
-  // and labelled.
+  // and labelled (one label a line lower than the previous, so that labels of
+  // close markers do not overlap).
   std::vector<double> x_markers;
   std::vector<std::string> x_marker_labels;
   // Slanted x tick labels (long category names), with room below the axis.
   bool slant_x_labels = false;
+  // Non-empty: the chart is inlined in an HTML page (e.g. report.html) rather
+  // than a file of its own: no XML declaration, and this id on the <svg>
+  // element and as the prefix of its internal ids, which must be unique
+  // within the page.
+  std::string inline_id;
 };
 
 // A line plot of the series, colors from a fixed palette in series order.

@@ -223,6 +223,16 @@ TEST(ColmapMain, RigCalibratorIsTheStandaloneCommand) {
     EXPECT_NE(extended.out.find("--output_path"), std::string::npos);
   }
 
+  // `report` (its only option is --calibration_path).
+  const Output standalone_report =
+      RunExecutable(Standalone(), {"report", "-h"});
+  const Output extended_report =
+      RunExecutable(Extended(), {"rig_calibrator", "report", "-h"});
+  EXPECT_EQ(standalone_report.exit_code, EXIT_SUCCESS);
+  EXPECT_EQ(extended_report.exit_code, EXIT_SUCCESS);
+  EXPECT_EQ(extended_report.out, standalone_report.out);
+  EXPECT_NE(extended_report.out.find("--calibration_path"), std::string::npos);
+
   // Its command list, with the usage naming `colmap rig_calibrator`.
   std::string expected = RunExecutable(Standalone(), {"help"}).out;
   for (size_t at = 0;

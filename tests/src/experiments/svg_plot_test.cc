@@ -125,6 +125,25 @@ TEST(SvgPlot, LinePlotIsWellFormedWithAxesAndLegend) {
   EXPECT_EQ(std::count(points.begin(), points.end(), ','), 5);
 }
 
+// Two charts inlined in one HTML page: no XML declaration, and ids of their
+// own, so that each polyline is clipped by its own chart's plot area.
+TEST(SvgPlot, InlineChartsHaveUniqueIdsAndNoDeclaration) {
+  PlotOptions options;
+  options.inline_id = "cam0-profile";
+  const std::vector<PlotSeries> series = {{"a", {0, 1, 2}, {1, 2, 3}, false}};
+  const std::string svg = LinePlotSvg(options, series);
+  std::map<std::string, int> counts;
+  std::string problem;
+  ASSERT_TRUE(WellFormed(svg, &counts, &problem)) << problem << "\n" << svg;
+  EXPECT_EQ(svg.find("<?xml"), std::string::npos);
+  EXPECT_EQ(svg.rfind("<svg id=\"cam0-profile\" xmlns=", 0), 0u);
+  EXPECT_NE(svg.find("<clipPath id=\"cam0-profile-plot-area\">"),
+            std::string::npos);
+  EXPECT_NE(svg.find("clip-path=\"url(#cam0-profile-plot-area)\""),
+            std::string::npos);
+  EXPECT_EQ(svg.find("\"plot-area\""), std::string::npos);
+}
+
 TEST(SvgPlot, BarChartHasOneBarPerValue) {
   PlotOptions options;
   options.title = "good";
