@@ -3,6 +3,8 @@
 #include <iomanip>
 #include <iostream>
 
+#include "colmap_ext/commands/coverage_report.h"
+
 namespace rig_calibrator {
 
 CalibrationSummary MakeCalibrationSummary(
@@ -22,6 +24,7 @@ CalibrationSummary MakeCalibrationSummary(
   for (const StageTiming& timing : report.timings) {
     summary.timings_s.emplace_back(timing.stage, timing.seconds);
   }
+  SetCoverageSummary(report, &summary);
   return summary;
 }
 
@@ -54,6 +57,7 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
               << camera.num_images << " RMS " << std::setprecision(3)
               << camera.rms_px << " px\n";
   }
+  PrintCoverage(summary);
   if (!summary.known_rig_source.empty()) {
     std::cout << "  against the known rig of " << summary.known_rig_source
               << " (cam_from_" << summary.known_rig_reference_camera << "):\n";

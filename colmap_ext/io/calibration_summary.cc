@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/coverage_json.h"
 #include "colmap_ext/io/rig_description.h"
 
 namespace rig_calibrator {
@@ -148,6 +149,7 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["num_inliers"] = camera.num_inliers;
     node["radial_rms_px"] = Number(camera.radial_rms_px);
     node["rms_px"] = Number(camera.rms_px);
+    AddCoverageJson(camera, &node);
     cameras.push_back(node);
   }
   root["cameras"] = cameras;

@@ -14,7 +14,9 @@
 #include <utility>
 #include <vector>
 
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/evaluation/image_coverage.h"
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
@@ -32,6 +34,10 @@ struct CameraSummary {
   // Root mean square over the inliers of all used images.
   double radial_rms_px = 0;
   double rms_px = 0;
+  // The coverage of the image by the inliers and what of the intrinsics was
+  // estimated (PipelineReport::coverage, refined_intrinsics; coverage_json.h).
+  std::optional<ImageCoverage> coverage;
+  std::optional<IntrinsicsRefinement> refined;
 };
 
 // Known cam_from_rig of the rig cameras, e.g. the sensor_from_rig of a

@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "src/calibration/coverage_diagnosis.h"
 #include "src/calibration/pipeline_stages.h"
 
 namespace rig_calibrator {
@@ -116,6 +117,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
     return false;
   }
   SummarizeCalibration(dataset, *calibration, report);
+  DiagnoseCoverage(dataset, *calibration, report);
   report->total_seconds = total_timer.ElapsedSeconds();
   return true;
 }

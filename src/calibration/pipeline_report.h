@@ -6,11 +6,14 @@
 
 #include <colmap/util/timer.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "src/calibration/calibration_method.h"
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/evaluation/image_coverage.h"
 
 namespace rig_calibrator {
 
@@ -49,6 +52,12 @@ struct PipelineReport {
   std::vector<colmap::Camera> initial_cameras;
   std::vector<Rigid3d> initial_cam_from_rig;
   std::vector<bool> initial_camera_calibrated;
+  // Per camera, the intrinsics the pipeline estimated (the others held at
+  // their given values); empty when it stopped before the final adjustment.
+  std::vector<IntrinsicsRefinement> refined_intrinsics;
+  // Per camera, the coverage of its image by the final inliers (none for a
+  // camera that was not calibrated; coverage_diagnosis.h).
+  std::vector<std::optional<ImageCoverage>> coverage;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

@@ -120,8 +120,13 @@ void UpgradeCameras(const PipelineOptions& options, const RigDataset& dataset,
   for (int c = 0; c < num_cameras; ++c) {
     if (!calibration->camera_calibrated[c]) continue;
     inputs[c] = GatherUpgradeInput(dataset, *calibration, c);
+    CameraUpgradeOptions upgrade_options = options.upgrade;
+    const IntrinsicsRefinement& refinement = dataset.cameras[c].refinement;
+    upgrade_options.refine_focal_length &= refinement.focal_length;
+    upgrade_options.refine_principal_point &= refinement.principal_point;
+    upgrade_options.refine_extra_params &= refinement.extra_params;
     success[c] =
-        UpgradeCamera(options.upgrade, inputs[c].points2D, inputs[c].points_cam,
+        UpgradeCamera(upgrade_options, inputs[c].points2D, inputs[c].points_cam,
                       &calibration->cameras[c], &results[c]);
   }
   for (int c = 0; c < num_cameras; ++c) {
@@ -154,7 +159,8 @@ void AnchorRigAtReferenceCamera(int reference_camera,
 
 // Per-camera intrinsics for the full-pose methods that estimate them per
 // image: the element-wise median (colmap::Median: the mean of the two middle
-// values for an even count) of the localized images' parameters.
+// values for an even count) of the localized images' parameters; the held
+// ones are the dataset camera's.
 void MedianIntrinsics(const RigDataset& dataset,
                       const std::vector<colmap::Camera>& per_image_cameras,
                       RigCalibration* calibration) {
@@ -175,6 +181,8 @@ void MedianIntrinsics(const RigDataset& dataset,
       median[p] = colmap::Median(values[p]);
     }
     calibration->cameras[c].SetParams(median);
+    RestoreHeldParams(dataset.cameras[c].camera, dataset.cameras[c].refinement,
+                      &calibration->cameras[c]);
   }
 }
 
@@ -275,6 +283,17 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
     ba_options.refine_focal_length = false;
     ba_options.refine_principal_point = false;
     ba_options.refine_extra_params = false;
+  }
+  // What was estimated of each camera's intrinsics in the whole pipeline:
+  // the final adjustment's refinement (the known* methods estimate nothing
+  // before it, the others hold the same parameters in every stage).
+  report->refined_intrinsics.clear();
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    report->refined_intrinsics.push_back(
+        IntrinsicsRefinement{ba_options.refine_focal_length,
+                             ba_options.refine_principal_point,
+                             ba_options.refine_extra_params}
+            .And(dataset.cameras[c].refinement));
   }
   FinalBundleAdjustmentSummary summary;
   if (!AdjustRig(ba_options, dataset, calibration, &summary)) {

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
@@ -34,10 +35,13 @@ struct RigImage {
 // One camera of the rig. `camera` carries the model, the image size and the
 // parameters: initial values (principal point at the image center) or, with
 // `intrinsics_known`, the given intrinsics (the `known*` methods).
+// `refinement`: COLMAP's refine_* switches for this camera; the parameters
+// it holds keep camera's values in every stage (intrinsics_refinement.h).
 struct RigCamera {
   std::string name;  // the folder, e.g. "cam0"
   colmap::Camera camera;
   bool intrinsics_known = false;
+  IntrinsicsRefinement refinement;
 };
 
 // One observation of a map point by a map image: the keypoint and its index
