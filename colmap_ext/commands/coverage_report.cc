@@ -37,8 +37,8 @@ void PrintCoverage(const CalibrationSummary& summary) {
               << " % of " << coverage.grid_cols << "x" << coverage.grid_rows
               << " cells, radius " << std::setprecision(1)
               << coverage.max_observed_radius_px << " of "
-              << coverage.corner_radius_px << " px ("
-              << std::setprecision(0) << 100 * coverage.radius_ratio << " %)"
+              << coverage.corner_radius_px << " px (" << std::setprecision(0)
+              << 100 * coverage.radius_ratio << " %)"
               << (held.empty() ? "" : "; held at the given values: " + held)
               << "\n"
               << std::defaultfloat;

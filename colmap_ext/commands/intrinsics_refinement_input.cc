@@ -24,11 +24,14 @@ bool ParseSwitch(const std::string& option, const std::string& value,
     boost::trim(item);
     if (item.empty()) continue;
     const size_t colon = item.find(':');
-    std::string flag = colon == std::string::npos ? item : item.substr(colon + 1);
+    std::string flag =
+        colon == std::string::npos ? item : item.substr(colon + 1);
     boost::trim(flag);
     if (flag != "0" && flag != "1") {
-      *error = "--RigCalibrator." + option + " takes 0 or 1, for every camera "
-               "or per camera (cam0:0,cam1:1), not '" + item + "'";
+      *error = "--RigCalibrator." + option +
+               " takes 0 or 1, for every camera "
+               "or per camera (cam0:0,cam1:1), not '" +
+               item + "'";
       return false;
     }
     if (colon == std::string::npos) {
@@ -59,7 +62,8 @@ bool ParseSwitch(const std::string& option, const std::string& value,
 bool GivenIntrinsics(
     const CalibrateOptions& options,
     const std::map<std::string, DatabaseCamera>& database_cameras,
-    const RigDataset& dataset, std::vector<std::optional<colmap::Camera>>* given,
+    const RigDataset& dataset,
+    std::vector<std::optional<colmap::Camera>>* given,
     std::vector<std::string>* sources, std::string* error) {
   given->assign(dataset.cameras.size(), std::nullopt);
   sources->assign(dataset.cameras.size(), "");
@@ -70,8 +74,8 @@ bool GivenIntrinsics(
       for (const RigDescriptionCamera& camera : rig.cameras) {
         if (camera.name == dataset.cameras[c].name && camera.camera) {
           (*given)[c] = *camera.camera;
-          (*sources)[c] = "--RigCalibrator.intrinsics_path " +
-                          options.intrinsics_path;
+          (*sources)[c] =
+              "--RigCalibrator.intrinsics_path " + options.intrinsics_path;
         }
       }
     }
@@ -152,12 +156,12 @@ bool SetIntrinsicsRefinement(
     const std::map<std::string, DatabaseCamera>& database_cameras,
     RigDataset* dataset, std::string* error) {
   std::vector<bool> focal, principal_point, extra;
-  if (!ParseSwitch("refine_focal_length", options.refine_focal_length,
-                   *dataset, &focal, error) ||
+  if (!ParseSwitch("refine_focal_length", options.refine_focal_length, *dataset,
+                   &focal, error) ||
       !ParseSwitch("refine_principal_point", options.refine_principal_point,
                    *dataset, &principal_point, error) ||
-      !ParseSwitch("refine_extra_params", options.refine_extra_params,
-                   *dataset, &extra, error)) {
+      !ParseSwitch("refine_extra_params", options.refine_extra_params, *dataset,
+                   &extra, error)) {
     return false;
   }
   bool holds_any = false;
@@ -176,14 +180,15 @@ bool SetIntrinsicsRefinement(
   for (size_t c = 0; c < dataset->cameras.size(); ++c) {
     RigCamera& camera = dataset->cameras[c];
     if (given[c]) {
-      if (!CopyHeldParams(*given[c], sources[c], camera.refinement,
-                          camera.name, &camera.camera, error)) {
+      if (!CopyHeldParams(*given[c], sources[c], camera.refinement, camera.name,
+                          &camera.camera, error)) {
         return false;
       }
     } else if (!camera.refinement.focal_length) {
       *error =
           "--RigCalibrator.refine_focal_length 0 holds the focal length of "
-          "camera " + camera.name +
+          "camera " +
+          camera.name +
           ", but no focal length is given for it: give "
           "--RigCalibrator.intrinsics_path (a rig_config.json or "
           "camchain.yaml with its intrinsics), or extract its features with "

@@ -271,9 +271,8 @@ void BuildRefinementProblem(const CameraUpgradeOptions& options,
   if (static_cast<int>(held.size()) == CameraModel::kNumParams) {
     problem->SetParameterBlockConstant(params->data());
   } else if (!held.empty()) {
-    problem->SetManifold(
-        params->data(),
-        new ceres::SubsetManifold(CameraModel::kNumParams, held));
+    problem->SetManifold(params->data(), new ceres::SubsetManifold(
+                                             CameraModel::kNumParams, held));
   }
   ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
   blocks->clear();

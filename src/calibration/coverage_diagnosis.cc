@@ -22,7 +22,8 @@ void DiagnoseCoverage(const RigDataset& dataset,
   report->coverage.assign(num_cameras, std::nullopt);
   for (size_t c = 0; c < num_cameras; ++c) {
     if (!calibration.camera_calibrated[c]) continue;
-    report->coverage[c] = ComputeImageCoverage(calibration.cameras[c], points[c]);
+    report->coverage[c] =
+        ComputeImageCoverage(calibration.cameras[c], points[c]);
     std::string why;
     if (IsPoorCoverage(*report->coverage[c], &why)) {
       AddDiagnostic(report, Diagnostic::Level::kWarning, "poor_coverage",

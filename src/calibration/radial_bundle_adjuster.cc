@@ -385,8 +385,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   // wrong image's points always fall near the predicted lines), the
   // remaining correspondences beyond it too, and the rest solved again.
   ceres::Solver::Summary solver_summary =
-      Solve(options, observations, reference, dataset.cameras,
-                            &parameters);
+      Solve(options, observations, reference, dataset.cameras, &parameters);
   int num_iterations = solver_summary.iterations.size();
   int num_outliers = 0;
   if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
@@ -399,8 +398,8 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
       if (!ObservesReference(observations, reference)) {
         return Fail(no_reference_message + " after removing outliers", summary);
       }
-      solver_summary = Solve(options, observations, reference, dataset.cameras,
-                            &parameters);
+      solver_summary =
+          Solve(options, observations, reference, dataset.cameras, &parameters);
       num_iterations += solver_summary.iterations.size();
     }
   }

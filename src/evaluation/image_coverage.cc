@@ -14,8 +14,8 @@ ImageCoverage ComputeImageCoverage(
   const double height = static_cast<double>(camera.Height());
   const double longer = std::max(width, height);
   const int shorter_cells = std::max(
-      1, static_cast<int>(std::lround(kGridCells * std::min(width, height) /
-                                      longer)));
+      1, static_cast<int>(
+             std::lround(kGridCells * std::min(width, height) / longer)));
   coverage.grid_cols = width >= height ? kGridCells : shorter_cells;
   coverage.grid_rows = width >= height ? shorter_cells : kGridCells;
   coverage.counts.assign(coverage.grid_cols * coverage.grid_rows, 0);
@@ -33,20 +33,20 @@ ImageCoverage ComputeImageCoverage(
         point.x() >= width || point.y() >= height) {
       continue;
     }
-    const int col = std::min(coverage.grid_cols - 1,
-                             static_cast<int>(point.x() / width *
-                                              coverage.grid_cols));
-    const int row = std::min(coverage.grid_rows - 1,
-                             static_cast<int>(point.y() / height *
-                                              coverage.grid_rows));
+    const int col =
+        std::min(coverage.grid_cols - 1,
+                 static_cast<int>(point.x() / width * coverage.grid_cols));
+    const int row =
+        std::min(coverage.grid_rows - 1,
+                 static_cast<int>(point.y() / height * coverage.grid_rows));
     ++coverage.counts[row * coverage.grid_cols + col];
     ++coverage.num_points;
     coverage.max_observed_radius_px = std::max(
         coverage.max_observed_radius_px, (point - principal_point).norm());
   }
-  const int num_covered = static_cast<int>(std::count_if(
-      coverage.counts.begin(), coverage.counts.end(),
-      [](const int count) { return count > 0; }));
+  const int num_covered = static_cast<int>(
+      std::count_if(coverage.counts.begin(), coverage.counts.end(),
+                    [](const int count) { return count > 0; }));
   coverage.fraction_cells =
       static_cast<double>(num_covered) / coverage.counts.size();
   coverage.radius_ratio =
@@ -68,9 +68,9 @@ bool IsPoorCoverage(const ImageCoverage& coverage, std::string* why) {
   }
   if (coverage.fraction_cells < kMinFractionCells) {
     text << (text.tellp() > 0 ? "; " : "") << "observations in "
-         << 100 * coverage.fraction_cells << " % of the "
-         << coverage.grid_cols << "x" << coverage.grid_rows
-         << " image cells (below " << 100 * kMinFractionCells << " %)";
+         << 100 * coverage.fraction_cells << " % of the " << coverage.grid_cols
+         << "x" << coverage.grid_rows << " image cells (below "
+         << 100 * kMinFractionCells << " %)";
   }
   *why = text.str();
   return !why->empty();

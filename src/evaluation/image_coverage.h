@@ -50,8 +50,8 @@ struct ImageCoverage {
 // The coverage of `camera`'s image (its size and principal point) by
 // `points2D` (pixels, COLMAP convention); points outside the image or not
 // finite are ignored. Requires a camera with a positive width and height.
-ImageCoverage ComputeImageCoverage(const colmap::Camera& camera,
-                                   const std::vector<Eigen::Vector2d>& points2D);
+ImageCoverage ComputeImageCoverage(
+    const colmap::Camera& camera, const std::vector<Eigen::Vector2d>& points2D);
 
 // Whether the coverage is poor (see above); *why gets the numbers and what
 // they mean, empty when it is not.

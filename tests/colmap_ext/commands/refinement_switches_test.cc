@@ -3,11 +3,11 @@
 // bit) its given value in every output that carries it (the COLMAP model's
 // cameras, camchain.yaml, rig_config.json, calibration_summary.json), and
 // bad values or a held focal length without a given one are refused.
+#include <colmap/base/reconstruction.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <boost/filesystem.hpp>
-#include <colmap/base/reconstruction.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -90,8 +90,7 @@ class RefinementSwitchesTest : public ::testing::Test {
     for (const std::string file : {"camchain.yaml", "rig_config.json"}) {
       RigDescription rig;
       std::string error;
-      EXPECT_TRUE(ReadRigReference(output + "/" + file, &rig, &error))
-          << error;
+      EXPECT_TRUE(ReadRigReference(output + "/" + file, &rig, &error)) << error;
       for (const RigDescriptionCamera& camera : rig.cameras) {
         params[camera.name].push_back(camera.camera->Params());
       }
@@ -110,7 +109,6 @@ class RefinementSwitchesTest : public ::testing::Test {
   std::map<std::string, std::vector<double>> given_;
   nlohmann::json summary_;
 };
-
 
 TEST_F(RefinementSwitchesTest, HeldParametersAreExactInEveryOutput) {
   const std::vector<std::pair<std::string, std::vector<int>>> cases = {
@@ -156,8 +154,8 @@ TEST_F(RefinementSwitchesTest, HeldParametersAreExactInEveryOutput) {
 // cam1:0 holds cam1's principal point only.
 TEST_F(RefinementSwitchesTest, PerCameraSwitch) {
   const std::string output = temp_.File("per_camera");
-  ASSERT_EQ(RunCommand(&RunCalibrate, Arguments(output, "refine_principal_point",
-                                                "cam1:0")),
+  ASSERT_EQ(RunCommand(&RunCalibrate,
+                       Arguments(output, "refine_principal_point", "cam1:0")),
             EXIT_SUCCESS);
   for (const auto& [name, params] : OutputParams(output)) {
     for (const std::vector<double>& output_params : params) {
@@ -170,9 +168,12 @@ TEST_F(RefinementSwitchesTest, PerCameraSwitch) {
 // refused; nothing is written.
 TEST_F(RefinementSwitchesTest, BadSwitchesAreRefused) {
   const std::string output = temp_.File("bad");
-  std::vector<std::string> no_given = {
-      "--correspondences_path", data_ + "/correspondences.txt",
-      "--output_path", output, "--RigCalibrator.refine_focal_length", "0"};
+  std::vector<std::string> no_given = {"--correspondences_path",
+                                       data_ + "/correspondences.txt",
+                                       "--output_path",
+                                       output,
+                                       "--RigCalibrator.refine_focal_length",
+                                       "0"};
   EXPECT_EQ(RunCommand(&RunCalibrate, no_given), EXIT_FAILURE);
   EXPECT_EQ(RunCommand(&RunCalibrate,
                        Arguments(output, "refine_principal_point", "2")),
@@ -182,9 +183,12 @@ TEST_F(RefinementSwitchesTest, BadSwitchesAreRefused) {
             EXIT_FAILURE);
   EXPECT_FALSE(fs::exists(output));
   // Without a given principal point, held means at the image centre.
-  std::vector<std::string> centre = {
-      "--correspondences_path", data_ + "/correspondences.txt",
-      "--output_path", output, "--RigCalibrator.refine_principal_point", "0"};
+  std::vector<std::string> centre = {"--correspondences_path",
+                                     data_ + "/correspondences.txt",
+                                     "--output_path",
+                                     output,
+                                     "--RigCalibrator.refine_principal_point",
+                                     "0"};
   ASSERT_EQ(RunCommand(&RunCalibrate, centre), EXIT_SUCCESS);
   std::ifstream summary_file(output + "/calibration_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);

@@ -83,8 +83,8 @@ TEST(IntrinsicsRefinement, HeldParametersStayExactlyAsGiven) {
       }
       RigCalibration calibration;
       PipelineReport report;
-      ASSERT_TRUE(CalibrateRig(QuietOptions(method), held.dataset,
-                               &calibration, &report))
+      ASSERT_TRUE(CalibrateRig(QuietOptions(method), held.dataset, &calibration,
+                               &report))
           << report.error;
       ASSERT_EQ(report.refined_intrinsics.size(), 5u);
       for (size_t c = 0; c < 5; ++c) {
@@ -125,7 +125,8 @@ TEST(IntrinsicsRefinement, KnownMethodsReportNothingRefined) {
     EXPECT_FALSE(report.refined_intrinsics[c].focal_length);
     EXPECT_FALSE(report.refined_intrinsics[c].principal_point);
     EXPECT_FALSE(report.refined_intrinsics[c].extra_params);
-    EXPECT_EQ(calibration.cameras[c].Params(), rig.dataset.cameras[c].camera.Params());
+    EXPECT_EQ(calibration.cameras[c].Params(),
+              rig.dataset.cameras[c].camera.Params());
   }
 }
 
@@ -149,8 +150,8 @@ TEST(IntrinsicsRefinement, PerCameraSwitch) {
 // held, the worst camera of the rig is at least as accurate as with the
 // principal point estimated (the measured numbers are printed).
 TEST(IntrinsicsRefinement, HeldTruePrincipalPointIsAtLeastAsAccurate) {
-  double free_rotation = 0, held_rotation = 0, free_center = 0,
-         held_center = 0, free_projection = 0, held_projection = 0;
+  double free_rotation = 0, held_rotation = 0, free_center = 0, held_center = 0,
+         free_projection = 0, held_projection = 0;
   int num_runs = 0;
   for (const int num_framesets : {5, 8}) {
     for (unsigned int seed = 1; seed <= 4; ++seed) {
@@ -160,8 +161,8 @@ TEST(IntrinsicsRefinement, HeldTruePrincipalPointIsAtLeastAsAccurate) {
       HoldAtTruth(rig, {true, false, true}, &held.dataset);
       RigCalibration free_calibration, held_calibration;
       PipelineReport report;
-      if (!CalibrateRig(QuietOptions(CalibrationMethod::kRadial1D),
-                        rig.dataset, &free_calibration, &report)) {
+      if (!CalibrateRig(QuietOptions(CalibrationMethod::kRadial1D), rig.dataset,
+                        &free_calibration, &report)) {
         continue;
       }
       ASSERT_TRUE(CalibrateRig(QuietOptions(CalibrationMethod::kRadial1D),

@@ -49,15 +49,14 @@ TEST(ImageCoverage, CountsAndRadiiOfKnownPoints) {
   EXPECT_DOUBLE_EQ(coverage.fraction_cells, 3.0 / 80);
   // The farthest corner from (300, 250) is (640, 0).
   EXPECT_DOUBLE_EQ(coverage.corner_radius_px, std::hypot(340.0, 250.0));
-  EXPECT_DOUBLE_EQ(coverage.max_observed_radius_px,
-                   std::hypot(339.5, 229.5));
+  EXPECT_DOUBLE_EQ(coverage.max_observed_radius_px, std::hypot(339.5, 229.5));
   EXPECT_DOUBLE_EQ(coverage.radius_ratio,
                    std::hypot(339.5, 229.5) / std::hypot(340.0, 250.0));
 }
 
 // Points on a grid over the whole image: full coverage, no warning; the
-// same points within 150 px of the centre (0.375 of the corner radius): both criteria fail, with the
-// numbers in the message.
+// same points within 150 px of the centre (0.375 of the corner radius): both
+// criteria fail, with the numbers in the message.
 TEST(ImageCoverage, PoorCoverageIsDetectedWithItsNumbers) {
   const colmap::Camera camera = Camera(640, 480);
   std::vector<Eigen::Vector2d> all, central;
