@@ -63,6 +63,24 @@ void AddRigCalibratorOptions(po::options_description* description,
                  "known intrinsics for the known* methods (rig_config.json "
                  "with camera_params, or camchain.yaml); default: the "
                  "database's cameras");
+  const std::string held =
+      " (0: held at its given value in every stage: from "
+      "--RigCalibrator.intrinsics_path, else the database camera's "
+      "--ImageReader.camera_params; COLMAP's bundle_adjuster meaning); 1 or "
+      "0 for every camera, or per camera: cam0:0,cam1:1; the known and "
+      "known_ra methods hold every intrinsic";
+  AddOption(description, "RigCalibrator.refine_focal_length",
+            &o->refine_focal_length,
+            "estimate the focal length" + held +
+                "; held without a given focal length is an error");
+  AddOption(description, "RigCalibrator.refine_principal_point",
+            &o->refine_principal_point,
+            "estimate the principal point" + held +
+                "; held without one given: the image centre");
+  AddOption(description, "RigCalibrator.refine_extra_params",
+            &o->refine_extra_params,
+            "estimate the distortion" + held +
+                "; held without one given: 0, no distortion");
   AddOption(description, "RigCalibrator.refine_points", &o->refine_points,
             "also refine the map points that rig images observe at least "
             "twice in the final bundle adjustment (the result is then "

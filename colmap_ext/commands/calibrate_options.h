@@ -28,6 +28,11 @@ struct CalibrateOptions {
   std::string camera_prefixes;
   double timestamp_tolerance = 0;
   std::string intrinsics_path;
+  // COLMAP's refinement switches, "1"/"0" or per camera "cam0:0,cam1:1"
+  // (intrinsics_refinement_input.h).
+  std::string refine_focal_length = "1";
+  std::string refine_principal_point = "1";
+  std::string refine_extra_params = "1";
   // On: a map built by COLMAP is less accurate than what the rig's own many
   // observations determine (rendered ring5: rotation 0.055 -> 0.006 deg,
   // projection difference 0.7 -> 0.08 px); the result stays anchored to the

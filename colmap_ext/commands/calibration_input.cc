@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 
+#include "colmap_ext/commands/intrinsics_refinement_input.h"
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/database_reader.h"
 #include "colmap_ext/io/rig_reference_io.h"
@@ -476,6 +477,9 @@ bool LoadFromDatabase(const CalibrateOptions& options,
       return false;
     }
   }
+  if (!SetIntrinsicsRefinement(options, cameras_by_name, dataset, error)) {
+    return false;
+  }
   return LocalizeDatasetImages(options, map, database, dataset, error);
 }
 
@@ -503,6 +507,7 @@ bool LoadFromCorrespondences(const CalibrateOptions& options,
   if (options.KnownIntrinsics()) {
     if (!SetKnownIntrinsics(options, {}, dataset, error)) return false;
   }
+  if (!SetIntrinsicsRefinement(options, {}, dataset, error)) return false;
   for (RigImage& image : dataset->images) {
     image.correspondences =
         std::move(images[index_by_name[image.name]].correspondences);

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "colmap_ext/commands/camera_model_lines.h"
+#include "colmap_ext/commands/coverage_report.h"
 #include "colmap_ext/io/model_validity_json.h"
 #include "colmap_ext/io/uncertainty_json.h"
 
@@ -46,6 +47,7 @@ CalibrationSummary MakeCalibrationSummary(
   for (const StageTiming& timing : report.timings) {
     summary.timings_s.emplace_back(timing.stage, timing.seconds);
   }
+  SetCoverageSummary(report, &summary);
   return summary;
 }
 
@@ -82,6 +84,7 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
            CameraNames(summary), CameraModels(summary), summary.uncertainty)) {
     std::cout << "  " << line << "\n";
   }
+  PrintCoverage(summary);
   if (!summary.known_rig_source.empty()) {
     std::cout << "  against the known rig of " << summary.known_rig_source
               << " (cam_from_" << summary.known_rig_reference_camera << "):\n";

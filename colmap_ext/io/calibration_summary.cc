@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/coverage_json.h"
 #include "colmap_ext/io/model_validity_json.h"
 #include "colmap_ext/io/rig_description.h"
 #include "colmap_ext/io/uncertainty_json.h"
@@ -151,6 +152,7 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["radial_rms_px"] = Number(camera.radial_rms_px);
     node["rms_px"] = Number(camera.rms_px);
     AddCameraModelJson(camera.camera_model, &node);
+    AddCoverageJson(camera, &node);
     cameras.push_back(node);
   }
   root["cameras"] = cameras;

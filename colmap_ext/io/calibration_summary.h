@@ -15,8 +15,10 @@
 #include <vector>
 
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/evaluation/calibration_uncertainty.h"
+#include "src/evaluation/image_coverage.h"
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
@@ -36,6 +38,10 @@ struct CameraSummary {
   double rms_px = 0;
   // Validity of the model and its automatic choice (model_validity_json.h).
   CameraModelReport camera_model;
+  // The coverage of the image by the inliers and what of the intrinsics was
+  // estimated (PipelineReport::coverage, refined_intrinsics; coverage_json.h).
+  std::optional<ImageCoverage> coverage;
+  std::optional<IntrinsicsRefinement> refined;
 };
 
 // Known cam_from_rig of the rig cameras, e.g. the sensor_from_rig of a

@@ -22,8 +22,16 @@ bool UpgradeOrChooseCameraModel(
     const std::vector<std::pair<int, int>>& rows, colmap::Camera* camera,
     CameraUpgradeResult* result, std::optional<ModelChoice>* choice) {
   choice->reset();
+  // The parameters the user holds (--RigCalibrator.refine_*) are held in
+  // the upgrade of every candidate model too.
+  CameraUpgradeOptions upgrade_options = options.upgrade;
+  const IntrinsicsRefinement& refinement =
+      dataset.cameras[camera_index].refinement;
+  upgrade_options.refine_focal_length &= refinement.focal_length;
+  upgrade_options.refine_principal_point &= refinement.principal_point;
+  upgrade_options.refine_extra_params &= refinement.extra_params;
   if (!dataset.cameras[camera_index].choose_model) {
-    return UpgradeCamera(options.upgrade, points2D, points_cam, camera, result);
+    return UpgradeCamera(upgrade_options, points2D, points_cam, camera, result);
   }
   std::vector<int> groups;
   groups.reserve(rows.size());
@@ -32,7 +40,7 @@ bool UpgradeOrChooseCameraModel(
   }
   ModelChoice model_choice;
   const bool success =
-      SelectCameraModel(options.model_selection, options.upgrade, points2D,
+      SelectCameraModel(options.model_selection, upgrade_options, points2D,
                         points_cam, groups, camera, result, &model_choice);
   *choice = model_choice;
   return success;

@@ -159,11 +159,16 @@ Conditioning ComputeConditioning(const ceres::Problem& problem,
       focal_variance += covariance(1 + i, 1 + j);
     }
   }
+  conditioning.singular = false;
+  conditioning.tz_variance = covariance(0, 0);
+  // A held focal length is not traded against tz.
+  if (focal_tangent_idxs.empty()) {
+    conditioning.tz_focal_correlation = 0;
+    return conditioning;
+  }
   const double num_focals = focal_tangent_idxs.size();
   tz_focal_covariance /= num_focals;
   focal_variance /= num_focals * num_focals;
-  conditioning.singular = false;
-  conditioning.tz_variance = covariance(0, 0);
   conditioning.focal_variance = focal_variance;
   conditioning.tz_focal_correlation =
       tz_focal_covariance / std::sqrt(covariance(0, 0) * focal_variance);
@@ -210,9 +215,22 @@ int EvaluateInliers(const std::vector<Eigen::Vector2d>& points2D,
   return num_inliers;
 }
 
+// The parameter indices the LM holds (the refine_* options), ascending.
+template <typename CameraModel>
+std::vector<int> HeldParamIdxsOfModel(const CameraUpgradeOptions& options) {
+  std::vector<int> held;
+  const auto hold = [&held](const std::vector<size_t>& idxs) {
+    held.insert(held.end(), idxs.begin(), idxs.end());
+  };
+  if (!options.refine_focal_length) hold(CameraModel::focal_length_idxs);
+  if (!options.refine_principal_point) hold(CameraModel::principal_point_idxs);
+  if (!options.refine_extra_params) hold(CameraModel::extra_params_idxs);
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
 // The parameters the LM refines: parameter index -> tangent index (-1 for a
-// fixed principal point coordinate), and the tangent indices of the focal
-// lengths.
+// held parameter), and the tangent indices of the refined focal lengths.
 struct RefinedParams {
   std::vector<int> tangent_idxs;
   std::vector<int> focal_tangent_idxs;
@@ -221,23 +239,23 @@ struct RefinedParams {
 
 template <typename CameraModel>
 RefinedParams RefinedParamsOfModel(const CameraUpgradeOptions& options) {
-  const std::vector<size_t>& principal_point_idxs =
-      CameraModel::principal_point_idxs;
+  const std::vector<int> held = HeldParamIdxsOfModel<CameraModel>(options);
   RefinedParams refined;
   for (size_t i = 0; i < CameraModel::kNumParams; ++i) {
-    const bool fixed = !options.refine_principal_point &&
-                       std::count(principal_point_idxs.begin(),
-                                  principal_point_idxs.end(), i) > 0;
+    const bool fixed =
+        std::count(held.begin(), held.end(), static_cast<int>(i)) > 0;
     refined.tangent_idxs.push_back(fixed ? -1 : refined.num_tangent_params++);
   }
   for (const size_t i : CameraModel::focal_length_idxs) {
-    refined.focal_tangent_idxs.push_back(refined.tangent_idxs[i]);
+    if (refined.tangent_idxs[i] >= 0) {
+      refined.focal_tangent_idxs.push_back(refined.tangent_idxs[i]);
+    }
   }
   return refined;
 }
 
 // The LM problem of one refinement round: tz and the model's parameters (the
-// principal point fixed unless refined), a Cauchy-robustified full
+// held ones fixed), a Cauchy-robustified full
 // reprojection residual per inlier.
 template <typename CameraModel>
 void BuildRefinementProblem(const CameraUpgradeOptions& options,
@@ -249,12 +267,12 @@ void BuildRefinementProblem(const CameraUpgradeOptions& options,
                             std::vector<ceres::ResidualBlockId>* blocks) {
   problem->AddParameterBlock(tz, 1);
   problem->AddParameterBlock(params->data(), CameraModel::kNumParams);
-  if (!options.refine_principal_point) {
-    const std::vector<size_t>& idxs = CameraModel::principal_point_idxs;
-    problem->SetManifold(
-        params->data(),
-        new ceres::SubsetManifold(CameraModel::kNumParams,
-                                  std::vector<int>(idxs.begin(), idxs.end())));
+  const std::vector<int> held = HeldParamIdxsOfModel<CameraModel>(options);
+  if (static_cast<int>(held.size()) == CameraModel::kNumParams) {
+    problem->SetParameterBlockConstant(params->data());
+  } else if (!held.empty()) {
+    problem->SetManifold(params->data(), new ceres::SubsetManifold(
+                                             CameraModel::kNumParams, held));
   }
   ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
   blocks->clear();
@@ -447,6 +465,17 @@ std::string CheckInput(const CameraUpgradeOptions& options,
            .allFinite()) {
     return "the principal point is not finite";
   }
+  for (const size_t i : camera.FocalLengthIdxs()) {
+    if (!options.refine_focal_length &&
+        !(std::isfinite(camera.Params(i)) && camera.Params(i) > 0)) {
+      return "the focal length to hold is not a finite positive value";
+    }
+  }
+  for (const size_t i : camera.ExtraParamsIdxs()) {
+    if (!options.refine_extra_params && !std::isfinite(camera.Params(i))) {
+      return "the distortion to hold is not finite";
+    }
+  }
   return "";
 }
 
@@ -487,21 +516,47 @@ bool EstimateInitialization(const CameraUpgradeOptions& options,
 }
 
 // Step 2: the model's parameters from the initialization: fx = fy = f, the
-// principal point, k1, k2 where the model has them, every other term 0.
-std::vector<double> InitialParams(const colmap::Camera& camera,
+// principal point, k1, k2 where the model has them, every other term 0; a
+// held focal length or distortion is the camera's.
+std::vector<double> InitialParams(const CameraUpgradeOptions& options,
+                                  const colmap::Camera& camera,
                                   const Initialization& init,
                                   const RadialIntrinsics& initial,
                                   const Eigen::Vector2d& principal_point) {
   std::vector<double> params(camera.NumParams(), 0.0);
   for (const size_t i : camera.FocalLengthIdxs()) {
-    params[i] = initial.focal;
+    params[i] = options.refine_focal_length ? initial.focal : camera.Params(i);
   }
   params[camera.PrincipalPointIdxs()[0]] = principal_point.x();
   params[camera.PrincipalPointIdxs()[1]] = principal_point.y();
-  for (int j = 0; j < init.num_radial_terms; ++j) {
-    params[camera.ExtraParamsIdxs()[j]] = initial.k[j];
+  if (options.refine_extra_params) {
+    for (int j = 0; j < init.num_radial_terms; ++j) {
+      params[camera.ExtraParamsIdxs()[j]] = initial.k[j];
+    }
+  } else {
+    for (const size_t i : camera.ExtraParamsIdxs()) {
+      params[i] = camera.Params(i);
+    }
   }
   return params;
+}
+
+// The LM's starting tz for a held focal length f_given: the RANSAC's
+// (f, tz) fit the image scale f / (c + tz) of the points, so with d the
+// median inlier depth c + tz of the RANSAC,
+//   tz' = (f_given / f) d - (d - tz)
+// keeps that scale at the median inlier.
+double InitialTzForHeldFocal(const RadialIntrinsics& initial,
+                             const double given_focal,
+                             const std::vector<Eigen::Vector3d>& points_cam,
+                             const std::vector<char>& inlier_mask) {
+  std::vector<double> depths;
+  for (size_t i = 0; i < points_cam.size(); ++i) {
+    if (inlier_mask[i]) depths.push_back(points_cam[i].z() + initial.tz);
+  }
+  if (depths.empty() || !(initial.focal > 0)) return initial.tz;
+  const double depth = colmap::Median(depths);
+  return given_focal / initial.focal * depth - (depth - initial.tz);
 }
 
 bool Fail(const std::string& message, CameraUpgradeResult* result) {
@@ -569,8 +624,11 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
   }
 
   std::vector<double> params =
-      InitialParams(*camera, init, initial, principal_point);
-  double tz = initial.tz;
+      InitialParams(options, *camera, init, initial, principal_point);
+  double tz = options.refine_focal_length
+                  ? initial.tz
+                  : InitialTzForHeldFocal(initial, camera->MeanFocalLength(),
+                                          points_cam, result->inlier_mask);
   if (!RefineUpgradeForModel(camera->ModelId(), options, points2D, points_cam,
                              valid, &tz, &params, result)) {
     result->tz = 0;

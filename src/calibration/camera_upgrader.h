@@ -43,7 +43,16 @@ struct CameraUpgradeOptions {
   int max_num_ransac_points = 10000;
   double loss_scale_px = 1.0;  // Cauchy scale in the final LM
   int max_num_iterations = 100;
+  // COLMAP's refine_* switches (intrinsics_refinement.h): a parameter not
+  // refined keeps the input camera's value. With the focal length held the
+  // RANSAC still draws (tz, f, k) hypotheses to find the inliers; the start
+  // of the LM takes the given f with tz scaled to keep the median inlier's
+  // image scale f / depth, and the LM estimates tz and the distortion.
+  // With the extra parameters held, the LM starts from and keeps the given
+  // distortion.
   bool refine_principal_point = true;
+  bool refine_focal_length = true;
+  bool refine_extra_params = true;
   int num_threads = 1;  // of the LM; <= 0: all cores
 };
 
@@ -88,8 +97,9 @@ bool IsUpgradeSupportedCameraModel(int model_id);
 // points2D: pixels (COLMAP convention). points_cam: camera-frame points
 // WITHOUT tz, i.e. R X + (tx, ty, 0), on the correct half-line of the radial
 // pose. camera: in: model_id, width, height, params (principal point = the
-// current estimate, e.g. from the radial BA; other params ignored); out: all
-// params of that model. Correspondences with non-finite values are outliers.
+// current estimate, e.g. from the radial BA; the focal length and extra
+// params are used only when held, see the options); out: all params of that
+// model. Correspondences with non-finite values are outliers.
 // Returns false (camera unchanged, result->error_message set and logged) for
 // bad input, an unsupported model or when no consistent model is found.
 bool UpgradeCamera(const CameraUpgradeOptions& options,

@@ -76,9 +76,11 @@ bool EstimateWithKnownIntrinsics(const InitialPoseOptions& options,
   return true;
 }
 
+// The intrinsics that `refinement` holds keep `camera`'s values.
 bool EstimatePoseAndIntrinsics(const InitialPoseOptions& options,
                                const RigImage& image,
                                const colmap::Camera& camera,
+                               const IntrinsicsRefinement& refinement,
                                ImageResult* result,
                                colmap::Camera* image_camera) {
   if (!EstimateRadial(options, image, camera, result)) {
@@ -97,8 +99,12 @@ bool EstimatePoseAndIntrinsics(const InitialPoseOptions& options,
     indices.push_back(k);
   }
   *image_camera = camera;
+  CameraUpgradeOptions upgrade_options = options.upgrade;
+  upgrade_options.refine_focal_length &= refinement.focal_length;
+  upgrade_options.refine_principal_point &= refinement.principal_point;
+  upgrade_options.refine_extra_params &= refinement.extra_params;
   CameraUpgradeResult upgrade;
-  if (!UpgradeCamera(options.upgrade, points2D, points_cam, image_camera,
+  if (!UpgradeCamera(upgrade_options, points2D, points_cam, image_camera,
                      &upgrade) ||
       upgrade.num_inliers < options.min_num_inliers) {
     result->single_image_cam_from_world.reset();
@@ -169,8 +175,10 @@ void EstimateInitialPoses(const InitialPoseOptions& options,
             EstimateWithKnownIntrinsics(options, image, camera, &result);
         break;
       case InitialPoseModel::kPoseAndIntrinsics:
-        localized = EstimatePoseAndIntrinsics(options, image, camera, &result,
-                                              &image_camera);
+        localized = EstimatePoseAndIntrinsics(
+            options, image, camera,
+            dataset.cameras[image.camera_index].refinement, &result,
+            &image_camera);
         break;
     }
     result.localized = localized;

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "src/calibration/camera_model_stage.h"
+#include "src/calibration/coverage_diagnosis.h"
 #include "src/calibration/pipeline_stages.h"
 
 namespace rig_calibrator {
@@ -121,6 +122,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
   CheckCameraModels(options, dataset, *calibration, report);
   RunUncertaintyEstimation(options, method, dataset, *calibration, report);
   SummarizeCalibration(dataset, *calibration, report);
+  DiagnoseCoverage(dataset, *calibration, report);
   report->total_seconds = total_timer.ElapsedSeconds();
   return true;
 }

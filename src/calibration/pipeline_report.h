@@ -6,13 +6,16 @@
 
 #include <colmap/util/timer.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/evaluation/calibration_uncertainty.h"
+#include "src/evaluation/image_coverage.h"
 
 namespace rig_calibrator {
 
@@ -60,6 +63,12 @@ struct PipelineReport {
   // Per dataset camera: its model's validity and automatic choice (empty
   // when the pipeline stopped before the final bundle adjustment).
   std::vector<CameraModelReport> camera_models;
+  // Per camera, the intrinsics the pipeline estimated (the others held at
+  // their given values); empty when it stopped before the final adjustment.
+  std::vector<IntrinsicsRefinement> refined_intrinsics;
+  // Per camera, the coverage of its image by the final inliers (none for a
+  // camera that was not calibrated; coverage_diagnosis.h).
+  std::vector<std::optional<ImageCoverage>> coverage;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

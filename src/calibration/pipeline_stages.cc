@@ -157,7 +157,8 @@ void AnchorRigAtReferenceCamera(int reference_camera,
 
 // Per-camera intrinsics for the full-pose methods that estimate them per
 // image: the element-wise median (colmap::Median: the mean of the two middle
-// values for an even count) of the localized images' parameters.
+// values for an even count) of the localized images' parameters; the held
+// ones are the dataset camera's.
 void MedianIntrinsics(const RigDataset& dataset,
                       const std::vector<colmap::Camera>& per_image_cameras,
                       RigCalibration* calibration) {
@@ -178,6 +179,8 @@ void MedianIntrinsics(const RigDataset& dataset,
       median[p] = colmap::Median(values[p]);
     }
     calibration->cameras[c].SetParams(median);
+    RestoreHeldParams(dataset.cameras[c].camera, dataset.cameras[c].refinement,
+                      &calibration->cameras[c]);
   }
 }
 
@@ -288,6 +291,17 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
   SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
   const FinalBundleAdjustmentOptions ba_options =
       FinalBundleAdjustmentOptionsFor(options, method, dataset);
+  // What was estimated of each camera's intrinsics in the whole pipeline:
+  // the final adjustment's refinement (the known* methods estimate nothing
+  // before it, the others hold the same parameters in every stage).
+  report->refined_intrinsics.clear();
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    report->refined_intrinsics.push_back(
+        IntrinsicsRefinement{ba_options.refine_focal_length,
+                             ba_options.refine_principal_point,
+                             ba_options.refine_extra_params}
+            .And(dataset.cameras[c].refinement));
+  }
   FinalBundleAdjustmentSummary summary;
   if (!AdjustRig(ba_options, dataset, calibration, &summary)) {
     report->error = "the final bundle adjustment failed (see above)";

@@ -98,10 +98,13 @@ std::vector<Observation> KeepDeterminedFramesets(
 // camera's pose is constant, every camera's tz is held, and so is the t_z of
 // one rig pose (the rig origin's slide along the reference axis moves every
 // rig pose's t_z; holding one removes that null direction). Rig poses form
-// the eliminated group of the Schur complement: no residual links two.
+// the eliminated group of the Schur complement: no residual links two. The
+// principal points of the cameras whose refinement holds them stay constant.
 ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
                              const std::vector<Observation>& observations,
-                             int reference_camera, Parameters* parameters) {
+                             int reference_camera,
+                             const std::vector<RigCamera>& cameras,
+                             Parameters* parameters) {
   const int num_cameras = parameters->cam_from_rig.size();
   const int num_framesets = parameters->rig_from_world.size();
   ceres::Problem problem;
@@ -143,7 +146,8 @@ ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
       problem.SetManifold(parameters->cam_from_rig[i].data(),
                           new ceres::SubsetManifold(6, {5}));
     }
-    if (!options.refine_principal_points) {
+    if (!options.refine_principal_points ||
+        !cameras[i].refinement.principal_point) {
       problem.SetParameterBlockConstant(parameters->principal_points[i].data());
     }
   }
@@ -393,7 +397,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   // wrong image's points always fall near the predicted lines), the
   // remaining correspondences beyond it too, and the rest solved again.
   ceres::Solver::Summary solver_summary =
-      Solve(options, observations, reference, &parameters);
+      Solve(options, observations, reference, dataset.cameras, &parameters);
   int num_iterations = solver_summary.iterations.size();
   int num_outliers = 0;
   if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
@@ -406,7 +410,8 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
       if (!ObservesReference(observations, reference)) {
         return Fail(no_reference_message + " after removing outliers", summary);
       }
-      solver_summary = Solve(options, observations, reference, &parameters);
+      solver_summary =
+          Solve(options, observations, reference, dataset.cameras, &parameters);
       num_iterations += solver_summary.iterations.size();
     }
   }

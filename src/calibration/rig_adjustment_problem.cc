@@ -117,19 +117,12 @@ void RigAdjustment::SetUpParameterBlocks(ceres::Problem* problem) {
     if (!problem->HasParameterBlock(params)) {
       continue;
     }
-    std::vector<int> constant_params;
-    const auto hold = [&](const std::vector<size_t>& idxs) {
-      constant_params.insert(constant_params.end(), idxs.begin(), idxs.end());
-    };
-    if (!options_.refine_focal_length) {
-      hold(cameras_[camera].FocalLengthIdxs());
-    }
-    if (!options_.refine_principal_point) {
-      hold(cameras_[camera].PrincipalPointIdxs());
-    }
-    if (!options_.refine_extra_params) {
-      hold(cameras_[camera].ExtraParamsIdxs());
-    }
+    const IntrinsicsRefinement method_refinement = {
+        options_.refine_focal_length, options_.refine_principal_point,
+        options_.refine_extra_params};
+    const std::vector<int> constant_params = HeldParamIdxs(
+        cameras_[camera],
+        method_refinement.And(dataset_.cameras[camera].refinement));
     const int num_params = static_cast<int>(cameras_[camera].NumParams());
     if (static_cast<int>(constant_params.size()) == num_params) {
       problem->SetParameterBlockConstant(params);

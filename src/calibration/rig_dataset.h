@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "src/calibration/intrinsics_refinement.h"
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
@@ -34,6 +35,8 @@ struct RigImage {
 // One camera of the rig. `camera` carries the model, the image size and the
 // parameters: initial values (principal point at the image center) or, with
 // `intrinsics_known`, the given intrinsics (the `known*` methods).
+// `refinement`: COLMAP's refine_* switches for this camera; the parameters
+// it holds keep camera's values in every stage (intrinsics_refinement.h).
 struct RigCamera {
   std::string name;  // the folder, e.g. "cam0"
   colmap::Camera camera;
@@ -42,6 +45,7 @@ struct RigCamera {
   // (--RigCalibrator.camera_model auto; model_selection.h): `camera`'s model
   // is a placeholder then.
   bool choose_model = false;
+  IntrinsicsRefinement refinement;
 };
 
 // One observation of a map point by a map image: the keypoint and its index

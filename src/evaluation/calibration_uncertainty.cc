@@ -67,16 +67,24 @@ Eigen::Matrix<double, 2, 6> PoseTangentJacobian(const RowMajor2x7& jacobian,
 }
 
 // The indices of the intrinsic parameters the final adjustment refines
-// (rig_adjustment_problem.cc: SetUpParameterBlocks).
+// (rig_adjustment_problem.cc: SetUpParameterBlocks): those the options and
+// the camera's own switches (--RigCalibrator.refine_*) both refine.
 std::vector<int> FreeIntrinsics(const FinalBundleAdjustmentOptions& options,
+                                const IntrinsicsRefinement& refinement,
                                 const colmap::Camera& camera) {
   std::vector<char> held(camera.NumParams(), 0);
   const auto hold = [&](const std::vector<size_t>& indices) {
     for (const size_t index : indices) held[index] = 1;
   };
-  if (!options.refine_focal_length) hold(camera.FocalLengthIdxs());
-  if (!options.refine_principal_point) hold(camera.PrincipalPointIdxs());
-  if (!options.refine_extra_params) hold(camera.ExtraParamsIdxs());
+  if (!options.refine_focal_length || !refinement.focal_length) {
+    hold(camera.FocalLengthIdxs());
+  }
+  if (!options.refine_principal_point || !refinement.principal_point) {
+    hold(camera.PrincipalPointIdxs());
+  }
+  if (!options.refine_extra_params || !refinement.extra_params) {
+    hold(camera.ExtraParamsIdxs());
+  }
   std::vector<int> free;
   for (size_t k = 0; k < held.size(); ++k) {
     if (!held[k]) free.push_back(static_cast<int>(k));
@@ -319,8 +327,9 @@ void UncertaintyProblem::CollectObservations() {
   for (const std::optional<Rigid3d>& pose : calibration_.rig_from_world) {
     rig_from_world_.push_back(pose ? ToArray(*pose) : PoseArray{});
   }
-  for (const colmap::Camera& camera : calibration_.cameras) {
-    free_intrinsics_.push_back(FreeIntrinsics(options_, camera));
+  for (size_t c = 0; c < calibration_.cameras.size(); ++c) {
+    free_intrinsics_.push_back(FreeIntrinsics(
+        options_, dataset_.cameras[c].refinement, calibration_.cameras[c]));
   }
   const auto point_index = [&](int64_t point3D_id) {
     const auto [it, inserted] =

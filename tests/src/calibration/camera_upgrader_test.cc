@@ -400,6 +400,55 @@ TEST(CameraUpgrader, FixedPrincipalPoint) {
   EXPECT_GT(shifted.result.rms_px, 0.1);
 }
 
+// COLMAP's refine_focal_length / refine_extra_params 0: exact data, the held
+// parameters given at the truth stay exactly there and tz and the other
+// parameters are recovered; a held focal length 2 % off stays exactly at
+// the given value (tz and the distortion absorb what they can).
+TEST(CameraUpgrader, HeldFocalLengthAndDistortion) {
+  for (const std::string model_name :
+       {"SIMPLE_RADIAL", "OPENCV", "OPENCV_FISHEYE"}) {
+    const ModelCase& model_case = FindModelCase(model_name);
+    const colmap::Camera truth =
+        MakeCamera(model_case.model_name, 640, 480, model_case.params);
+    const Scene scene = MakeScene(truth, SceneOptionsFor(model_case));
+    for (const bool hold_focal : {true, false}) {
+      SCOPED_TRACE(model_name + (hold_focal ? " focal" : " distortion"));
+      CameraUpgradeOptions options;
+      options.refine_focal_length = !hold_focal;
+      options.refine_extra_params = hold_focal;
+      colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(0, 0));
+      const std::vector<size_t>& held =
+          hold_focal ? truth.FocalLengthIdxs() : truth.ExtraParamsIdxs();
+      for (const size_t i : held) camera.Params(i) = truth.Params(i);
+      CameraUpgradeResult result;
+      ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam,
+                                &camera, &result))
+          << result.error_message;
+      for (const size_t i : held) {
+        EXPECT_EQ(camera.Params(i), truth.Params(i)) << "param " << i;
+      }
+      EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+      ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+                       kPrincipalPointTolerancePx, kDistortionTolerance);
+      EXPECT_LT(result.rms_px, 1e-6);
+    }
+    colmap::Camera off = MakeInputCamera(truth, Eigen::Vector2d(0, 0));
+    for (const size_t i : truth.FocalLengthIdxs()) {
+      off.Params(i) = 1.02 * truth.Params(i);
+    }
+    const std::vector<double> given = off.Params();
+    CameraUpgradeOptions options;
+    options.refine_focal_length = false;
+    CameraUpgradeResult result;
+    ASSERT_TRUE(
+        UpgradeCamera(options, scene.points2D, scene.points_cam, &off, &result))
+        << model_name << ": " << result.error_message;
+    for (const size_t i : truth.FocalLengthIdxs()) {
+      EXPECT_EQ(off.Params(i), given[i]) << model_name;
+    }
+  }
+}
+
 // The result depends only on the input, not on COLMAP's random state: equal
 // to the last bit after different seeds of COLMAP's generator.
 TEST(CameraUpgrader, Deterministic) {
