@@ -82,8 +82,9 @@ void AddUncertaintyJson(const CalibrationUncertainty& uncertainty, Json* root) {
     cameras[c]["uncertainty"] =
         has ? CameraJson(uncertainty, uncertainty.cameras[c]) : Json(nullptr);
   }
-  (*root)["uncertainty_method"] = uncertainty.computed
-                                      ? uncertainty.method
+  (*root)["uncertainty_method"] = uncertainty.computed ? uncertainty.method
+                                  : uncertainty.message.empty()
+                                      ? std::string("not computed")
                                       : "not computed: " + uncertainty.message;
 }
 

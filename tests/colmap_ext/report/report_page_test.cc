@@ -180,12 +180,14 @@ TEST(ReportPage, WithoutTheContractKeysSaysNotComputed) {
        {"no &quot;uncertainty&quot;", "no &quot;validity&quot; in the summary",
         "no camera has &quot;model_choice&quot;",
         "no &quot;refined&quot; in the summary",
-        "no &quot;uncertainty_method&quot;",
         "no &quot;uncertainty.projection_stddev_px.grid&quot;",
         "no &quot;coverage&quot; in the summary",
         "not computed (no &quot;center_in_rig_stddev&quot;)"}) {
     EXPECT_NE(html.find(reason), std::string::npos) << reason;
   }
+  // The summary writer's own word for an uncertainty it did not compute.
+  EXPECT_NE(html.find("<th>uncertainty method</th><td>not computed</td>"),
+            std::string::npos);
   // 3 x (residuals, coverage, distortion) + 2 rig views + framesets.
   EXPECT_NE(html.find("data-expected-figures=\"12\""), std::string::npos);
   // The diagnostics of the summary, by level.
