@@ -27,6 +27,16 @@ std::string ScopedTempDir::File(const std::string& name) const {
   return path_ + "/" + name;
 }
 
+colmap::Camera MakeCamera(const std::string& model, const int width,
+                          const int height, const std::vector<double>& params) {
+  colmap::Camera camera;
+  camera.SetModelIdFromName(model);
+  camera.SetWidth(width);
+  camera.SetHeight(height);
+  camera.SetParams(params);
+  return camera;
+}
+
 std::string ReadBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(file),

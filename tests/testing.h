@@ -1,9 +1,12 @@
 // Helpers shared by the tests.
 #pragma once
 
+#include <colmap/base/camera.h>
+
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace rig_calibrator {
 namespace testing {
@@ -24,6 +27,10 @@ class ScopedTempDir {
  private:
   std::string path_;
 };
+
+// A camera of the COLMAP model named `model` (e.g. "OPENCV_FISHEYE").
+colmap::Camera MakeCamera(const std::string& model, int width, int height,
+                          const std::vector<double>& params);
 
 // The bytes of a file ("" if it cannot be read).
 std::string ReadBytes(const std::string& path);

@@ -12,18 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "tests/testing.h"
+
 namespace rig_calibrator {
 namespace {
 
-colmap::Camera MakeCamera(const std::string& model, int width, int height,
-                          const std::vector<double>& params) {
-  colmap::Camera camera;
-  camera.SetModelIdFromName(model);
-  camera.SetWidth(width);
-  camera.SetHeight(height);
-  camera.SetParams(params);
-  return camera;
-}
+using testing::MakeCamera;
 
 struct Data {
   std::vector<Eigen::Vector2d> points2D;

@@ -10,18 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "tests/testing.h"
+
 namespace rig_calibrator {
 namespace {
 
-colmap::Camera MakeCamera(const std::string& model, int width, int height,
-                          const std::vector<double>& params) {
-  colmap::Camera camera;
-  camera.SetModelIdFromName(model);
-  camera.SetWidth(width);
-  camera.SetHeight(height);
-  camera.SetParams(params);
-  return camera;
-}
+using testing::MakeCamera;
 
 void Print(const std::string& what, const ModelValidity& validity) {
   std::cout << what << ": valid " << validity.valid << ", monotonic "

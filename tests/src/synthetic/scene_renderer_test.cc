@@ -9,6 +9,7 @@
 #include "src/synthetic/rendered_dataset.h"
 #include "src/synthetic/synthetic_rig.h"
 #include "src/synthetic/textured_scene.h"
+#include "tests/testing.h"
 
 namespace rig_calibrator {
 namespace {
@@ -18,15 +19,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-colmap::Camera MakeCamera(const std::string& model, int width, int height,
-                          const std::vector<double>& params) {
-  colmap::Camera camera;
-  camera.SetModelIdFromName(model);
-  camera.SetWidth(width);
-  camera.SetHeight(height);
-  camera.SetParams(params);
-  return camera;
-}
+using testing::MakeCamera;
 
 // cam_from_world of a camera at `center` looking along world +x, image x
 // along world -y, image y along world -z, then turned by `yaw` about z.
