@@ -5,16 +5,11 @@
 #include <cstdio>
 #include <sstream>
 
+#include "colmap_ext/report/figure_format.h"
 #include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {
-
-std::string Px(const double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.1f", value);
-  return text;
-}
 
 std::string Label(const double value) {
   char text[32];
@@ -52,19 +47,21 @@ std::string ColorBarSvg(const double x, const double y, const double height,
   std::ostringstream svg;
   const double step = height / kSteps;
   for (int k = 0; k < kSteps; ++k) {
-    svg << "<rect x=\"" << Px(x) << "\" y=\"" << Px(y + height - (k + 1) * step)
-        << "\" width=\"12\" height=\"" << Px(step + 0.5) << "\" fill=\""
-        << HeatColor((k + 0.5) / kSteps) << "\"/>";
+    svg << "<rect x=\"" << FormatSvgCoordinate(x) << "\" y=\""
+        << FormatSvgCoordinate(y + height - (k + 1) * step)
+        << "\" width=\"12\" height=\"" << FormatSvgCoordinate(step + 0.5)
+        << "\" fill=\"" << HeatColor((k + 0.5) / kSteps) << "\"/>";
   }
-  svg << "<rect x=\"" << Px(x) << "\" y=\"" << Px(y)
-      << "\" width=\"12\" height=\"" << Px(height)
-      << "\" fill=\"none\" stroke=\"#333\"/>"
-      << "<text x=\"" << Px(x + 16) << "\" y=\"" << Px(y + 10) << "\">"
-      << Label(high) << "</text>"
-      << "<text x=\"" << Px(x + 16) << "\" y=\"" << Px(y + height) << "\">"
-      << Label(low) << "</text>"
-      << "<text x=\"" << Px(x + 16) << "\" y=\"" << Px(y + height / 2 + 4)
-      << "\">" << XmlEscape(unit) << "</text>\n";
+  svg << "<rect x=\"" << FormatSvgCoordinate(x) << "\" y=\""
+      << FormatSvgCoordinate(y) << "\" width=\"12\" height=\""
+      << FormatSvgCoordinate(height) << "\" fill=\"none\" stroke=\"#333\"/>"
+      << "<text x=\"" << FormatSvgCoordinate(x + 16) << "\" y=\""
+      << FormatSvgCoordinate(y + 10) << "\">" << Label(high) << "</text>"
+      << "<text x=\"" << FormatSvgCoordinate(x + 16) << "\" y=\""
+      << FormatSvgCoordinate(y + height) << "\">" << Label(low) << "</text>"
+      << "<text x=\"" << FormatSvgCoordinate(x + 16) << "\" y=\""
+      << FormatSvgCoordinate(y + height / 2 + 4) << "\">" << XmlEscape(unit)
+      << "</text>\n";
   return svg.str();
 }
 
@@ -81,33 +78,42 @@ std::string HeatMapSvg(const HeatMapOptions& options,
   std::ostringstream svg;
   svg << "<svg id=\"" << XmlEscape(options.id)
       << "\" xmlns=\"http://www.w3.org/2000/svg\" width=\"380\" height=\""
-      << Px(height + kImageFigureTop + 12) << "\" font-family=\"sans-serif\" "
-      << "font-size=\"11\">\n<text x=\"" << Px(kImageFigureLeft)
+      << FormatSvgCoordinate(height + kImageFigureTop + 12)
+      << "\" font-family=\"sans-serif\" "
+      << "font-size=\"11\">\n<text x=\""
+      << FormatSvgCoordinate(kImageFigureLeft)
       << "\" y=\"18\" font-size=\"13\">" << XmlEscape(options.title)
       << "</text>\n";
   for (int row = 0; row < grid.rows; ++row) {
     for (int col = 0; col < grid.cols; ++col) {
       const double value = grid.values[row * grid.cols + col];
-      svg << "<rect x=\"" << Px(kImageFigureLeft + col * cell_width)
-          << "\" y=\"" << Px(kImageFigureTop + row * cell_height)
-          << "\" width=\"" << Px(cell_width + 0.3) << "\" height=\""
-          << Px(cell_height + 0.3) << "\" fill=\""
+      svg << "<rect x=\""
+          << FormatSvgCoordinate(kImageFigureLeft + col * cell_width)
+          << "\" y=\""
+          << FormatSvgCoordinate(kImageFigureTop + row * cell_height)
+          << "\" width=\"" << FormatSvgCoordinate(cell_width + 0.3)
+          << "\" height=\"" << FormatSvgCoordinate(cell_height + 0.3)
+          << "\" fill=\""
           << (std::isfinite(value) ? HeatColor(high > 0 ? value / high : 0)
                                    : std::string("#eeeeee"))
           << "\"/>";
     }
     svg << "\n";
   }
-  svg << "<rect x=\"" << Px(kImageFigureLeft) << "\" y=\""
-      << Px(kImageFigureTop) << "\" width=\"" << Px(kImageFigureWidth)
-      << "\" height=\"" << Px(height) << "\" fill=\"none\" stroke=\"#333\"/>\n";
+  svg << "<rect x=\"" << FormatSvgCoordinate(kImageFigureLeft) << "\" y=\""
+      << FormatSvgCoordinate(kImageFigureTop) << "\" width=\""
+      << FormatSvgCoordinate(kImageFigureWidth) << "\" height=\""
+      << FormatSvgCoordinate(height) << "\" fill=\"none\" stroke=\"#333\"/>\n";
   if (options.marker) {
     const double x = kImageFigureLeft + options.marker->x() * scale;
     const double y = kImageFigureTop + options.marker->y() * scale;
-    svg << "<circle cx=\"" << Px(x) << "\" cy=\"" << Px(y)
+    svg << "<circle cx=\"" << FormatSvgCoordinate(x) << "\" cy=\""
+        << FormatSvgCoordinate(y)
         << "\" r=\"6\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>"
-        << "<text x=\"" << Px(std::min(x + 8, kImageFigureWidth - 40))
-        << "\" y=\"" << Px(std::max(y - 8, kImageFigureTop + 10))
+        << "<text x=\""
+        << FormatSvgCoordinate(std::min(x + 8, kImageFigureWidth - 40))
+        << "\" y=\""
+        << FormatSvgCoordinate(std::max(y - 8, kImageFigureTop + 10))
         << "\" fill=\"#d62728\">" << XmlEscape(options.marker_label)
         << "</text>\n";
   }

@@ -5,17 +5,12 @@
 #include <cstdio>
 #include <sstream>
 
+#include "colmap_ext/report/figure_format.h"
 #include "colmap_ext/report/heat_map_figure.h"
 #include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {
-
-std::string Px(const double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.1f", value);
-  return text;
-}
 
 // An arrow from (x, y) by (dx, dy) pixels of the figure, with a head of a
 // quarter of its length (at most 5 pixels).
@@ -23,29 +18,23 @@ std::string Arrow(const double x, const double y, const double dx,
                   const double dy, const std::string& color) {
   const double length = std::hypot(dx, dy);
   if (length < 0.5) {
-    return "<circle cx=\"" + Px(x) + "\" cy=\"" + Px(y) + "\" r=\"1\" fill=\"" +
-           color + "\"/>";
+    return "<circle cx=\"" + FormatSvgCoordinate(x) + "\" cy=\"" +
+           FormatSvgCoordinate(y) + "\" r=\"1\" fill=\"" + color + "\"/>";
   }
   const double head = std::min(5.0, 0.25 * length);
   const double ux = dx / length, uy = dy / length;
   const double tip_x = x + dx, tip_y = y + dy;
   std::ostringstream path;
-  path << "<path d=\"M" << Px(x) << " " << Px(y) << "L" << Px(tip_x) << " "
-       << Px(tip_y) << "M" << Px(tip_x - head * (ux - 0.5 * uy)) << " "
-       << Px(tip_y - head * (uy + 0.5 * ux)) << "L" << Px(tip_x) << " "
-       << Px(tip_y) << "L" << Px(tip_x - head * (ux + 0.5 * uy)) << " "
-       << Px(tip_y - head * (uy - 0.5 * ux)) << "\" stroke=\"" << color
-       << "\" fill=\"none\" stroke-width=\"1.3\"/>";
+  path << "<path d=\"M" << FormatSvgCoordinate(x) << " "
+       << FormatSvgCoordinate(y) << "L" << FormatSvgCoordinate(tip_x) << " "
+       << FormatSvgCoordinate(tip_y) << "M"
+       << FormatSvgCoordinate(tip_x - head * (ux - 0.5 * uy)) << " "
+       << FormatSvgCoordinate(tip_y - head * (uy + 0.5 * ux)) << "L"
+       << FormatSvgCoordinate(tip_x) << " " << FormatSvgCoordinate(tip_y) << "L"
+       << FormatSvgCoordinate(tip_x - head * (ux + 0.5 * uy)) << " "
+       << FormatSvgCoordinate(tip_y - head * (uy - 0.5 * ux)) << "\" stroke=\""
+       << color << "\" fill=\"none\" stroke-width=\"1.3\"/>";
   return path.str();
-}
-
-// 1, 2 or 5 times a power of ten, at most `value`.
-double NiceBelow(const double value) {
-  const double power = std::pow(10.0, std::floor(std::log10(value)));
-  for (const double factor : {5.0, 2.0, 1.0}) {
-    if (factor * power <= value) return factor * power;
-  }
-  return power;
 }
 
 }  // namespace
@@ -69,12 +58,15 @@ std::string ResidualFieldSvg(const std::string& id, const std::string& title,
   std::ostringstream svg;
   svg << "<svg id=\"" << XmlEscape(id)
       << "\" xmlns=\"http://www.w3.org/2000/svg\" width=\"380\" height=\""
-      << Px(height + kImageFigureTop + 34) << "\" font-family=\"sans-serif\" "
-      << "font-size=\"11\">\n<text x=\"" << Px(kImageFigureLeft)
+      << FormatSvgCoordinate(height + kImageFigureTop + 34)
+      << "\" font-family=\"sans-serif\" "
+      << "font-size=\"11\">\n<text x=\""
+      << FormatSvgCoordinate(kImageFigureLeft)
       << "\" y=\"18\" font-size=\"13\">" << XmlEscape(title) << "</text>\n";
-  svg << "<rect x=\"" << Px(kImageFigureLeft) << "\" y=\""
-      << Px(kImageFigureTop) << "\" width=\"" << Px(kImageFigureWidth)
-      << "\" height=\"" << Px(height) << "\" fill=\"#eeeeee\"/>\n";
+  svg << "<rect x=\"" << FormatSvgCoordinate(kImageFigureLeft) << "\" y=\""
+      << FormatSvgCoordinate(kImageFigureTop) << "\" width=\""
+      << FormatSvgCoordinate(kImageFigureWidth) << "\" height=\""
+      << FormatSvgCoordinate(height) << "\" fill=\"#eeeeee\"/>\n";
   for (int row = 0; row < residuals.rows; ++row) {
     for (int col = 0; col < residuals.cols; ++col) {
       const ResidualCell& cell = residuals.cells[row * residuals.cols + col];
@@ -82,9 +74,11 @@ std::string ResidualFieldSvg(const std::string& id, const std::string& title,
       const double rms = std::sqrt(cell.sum_squared / cell.count);
       const double x = kImageFigureLeft + col * cell_width;
       const double y = kImageFigureTop + row * cell_height;
-      svg << "<rect x=\"" << Px(x) << "\" y=\"" << Px(y) << "\" width=\""
-          << Px(cell_width + 0.3) << "\" height=\"" << Px(cell_height + 0.3)
-          << "\" fill=\"" << HeatColor(max_rms > 0 ? rms / max_rms : 0)
+      svg << "<rect x=\"" << FormatSvgCoordinate(x) << "\" y=\""
+          << FormatSvgCoordinate(y) << "\" width=\""
+          << FormatSvgCoordinate(cell_width + 0.3) << "\" height=\""
+          << FormatSvgCoordinate(cell_height + 0.3) << "\" fill=\""
+          << HeatColor(max_rms > 0 ? rms / max_rms : 0)
           << "\" fill-opacity=\"0.55\"/>"
           << Arrow(x + 0.5 * cell_width, y + 0.5 * cell_height,
                    arrow_scale * cell.sum_dx / cell.count,
@@ -92,20 +86,22 @@ std::string ResidualFieldSvg(const std::string& id, const std::string& title,
           << "\n";
     }
   }
-  svg << "<rect x=\"" << Px(kImageFigureLeft) << "\" y=\""
-      << Px(kImageFigureTop) << "\" width=\"" << Px(kImageFigureWidth)
-      << "\" height=\"" << Px(height) << "\" fill=\"none\" stroke=\"#333\"/>\n";
+  svg << "<rect x=\"" << FormatSvgCoordinate(kImageFigureLeft) << "\" y=\""
+      << FormatSvgCoordinate(kImageFigureTop) << "\" width=\""
+      << FormatSvgCoordinate(kImageFigureWidth) << "\" height=\""
+      << FormatSvgCoordinate(height) << "\" fill=\"none\" stroke=\"#333\"/>\n";
   const double legend_y = kImageFigureTop + height + 20;
   if (arrow_scale > 0) {
     const double legend_px = NiceBelow(max_mean);
     svg << Arrow(kImageFigureLeft, legend_y - 4, arrow_scale * legend_px, 0,
                  "#000000")
-        << "<text x=\"" << Px(kImageFigureLeft + arrow_scale * legend_px + 6)
-        << "\" y=\"" << Px(legend_y) << "\">mean residual " << legend_px
-        << " px</text>\n";
+        << "<text x=\""
+        << FormatSvgCoordinate(kImageFigureLeft + arrow_scale * legend_px + 6)
+        << "\" y=\"" << FormatSvgCoordinate(legend_y) << "\">mean residual "
+        << legend_px << " px</text>\n";
   } else {
-    svg << "<text x=\"" << Px(kImageFigureLeft) << "\" y=\"" << Px(legend_y)
-        << "\">no residuals</text>\n";
+    svg << "<text x=\"" << FormatSvgCoordinate(kImageFigureLeft) << "\" y=\""
+        << FormatSvgCoordinate(legend_y) << "\">no residuals</text>\n";
   }
   svg << ColorBarSvg(kImageFigureLeft + kImageFigureWidth + 12, kImageFigureTop,
                      std::min(height, 160.0), 0, max_rms, "RMS px")

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "colmap_ext/report/figure_format.h"
 #include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
@@ -14,24 +15,10 @@ constexpr double kSize = 340;   // square drawing area, pixels
 constexpr double kMargin = 40;  // around it, for labels
 constexpr double kTitle = 24;   // title line above
 
-std::string Px(const double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.1f", value);
-  return text;
-}
-
 // The two rig coordinates a view shows, as (right, up) on the page.
 Eigen::Vector2d Project(const RigView view, const Eigen::Vector3d& point) {
   return view == RigView::kFromAbove ? Eigen::Vector2d(point.x(), point.z())
                                      : Eigen::Vector2d(point.z(), -point.y());
-}
-
-double NiceBelow(const double value) {
-  const double power = std::pow(10.0, std::floor(std::log10(value)));
-  for (const double factor : {5.0, 2.0, 1.0}) {
-    if (factor * power <= value) return factor * power;
-  }
-  return power;
 }
 
 }  // namespace
@@ -77,8 +64,9 @@ RigViewFigure RigViewSvg(const std::string& id, const RigView view,
   const double width = kSize + 2 * kMargin;
   const double height = kSize + 2 * kMargin + kTitle + 10;
   svg << "<svg id=\"" << XmlEscape(id)
-      << "\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Px(width)
-      << "\" height=\"" << Px(height)
+      << "\" xmlns=\"http://www.w3.org/2000/svg\" width=\""
+      << FormatSvgCoordinate(width) << "\" height=\""
+      << FormatSvgCoordinate(height)
       << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
       << "<text x=\"10\" y=\"18\" font-size=\"13\">"
       << (view == RigView::kFromAbove
@@ -92,9 +80,10 @@ RigViewFigure RigViewSvg(const std::string& id, const RigView view,
       const Eigen::Vector2d radii =
           scale * Project(view, *camera.center_stddev).cwiseAbs();
       if (radii.maxCoeff() >= 1) {
-        svg << "<ellipse cx=\"" << Px(center.x()) << "\" cy=\""
-            << Px(center.y()) << "\" rx=\"" << Px(radii.x()) << "\" ry=\""
-            << Px(radii.y())
+        svg << "<ellipse cx=\"" << FormatSvgCoordinate(center.x()) << "\" cy=\""
+            << FormatSvgCoordinate(center.y()) << "\" rx=\""
+            << FormatSvgCoordinate(radii.x()) << "\" ry=\""
+            << FormatSvgCoordinate(radii.y())
             << "\" fill=\"#ff7f0e\" fill-opacity=\"0.3\" stroke=\"#ff7f0e\"/>";
       } else {
         figure.ellipses_too_small.push_back(camera.name);
@@ -103,25 +92,31 @@ RigViewFigure RigViewSvg(const std::string& id, const RigView view,
     for (int axis = 0; axis < 3; ++axis) {
       const Eigen::Vector2d tip = page(
           camera.center_in_rig + axis_length * camera.rig_from_cam.col(axis));
-      svg << "<line x1=\"" << Px(center.x()) << "\" y1=\"" << Px(center.y())
-          << "\" x2=\"" << Px(tip.x()) << "\" y2=\"" << Px(tip.y())
-          << "\" stroke=\"" << kAxisColors[axis] << "\" stroke-width=\""
-          << (axis == 2 ? 2.5 : 1.5) << "\"/>";
+      svg << "<line x1=\"" << FormatSvgCoordinate(center.x()) << "\" y1=\""
+          << FormatSvgCoordinate(center.y()) << "\" x2=\""
+          << FormatSvgCoordinate(tip.x()) << "\" y2=\""
+          << FormatSvgCoordinate(tip.y()) << "\" stroke=\"" << kAxisColors[axis]
+          << "\" stroke-width=\"" << (axis == 2 ? 2.5 : 1.5) << "\"/>";
     }
-    svg << "<circle cx=\"" << Px(center.x()) << "\" cy=\"" << Px(center.y())
-        << "\" r=\"3\" fill=\"black\"/><text x=\"" << Px(center.x() + 5)
-        << "\" y=\"" << Px(center.y() - 5) << "\">" << XmlEscape(camera.name)
-        << "</text>\n";
+    svg << "<circle cx=\"" << FormatSvgCoordinate(center.x()) << "\" cy=\""
+        << FormatSvgCoordinate(center.y())
+        << "\" r=\"3\" fill=\"black\"/><text x=\""
+        << FormatSvgCoordinate(center.x() + 5) << "\" y=\""
+        << FormatSvgCoordinate(center.y() - 5) << "\">"
+        << XmlEscape(camera.name) << "</text>\n";
   }
   // Scale bar and axis colours.
   const double bar = NiceBelow(0.4 * span);
   const double bar_y = height - 12;
-  svg << "<line x1=\"10\" y1=\"" << Px(bar_y) << "\" x2=\""
-      << Px(10 + bar * scale) << "\" y2=\"" << Px(bar_y)
+  svg << "<line x1=\"10\" y1=\"" << FormatSvgCoordinate(bar_y) << "\" x2=\""
+      << FormatSvgCoordinate(10 + bar * scale) << "\" y2=\""
+      << FormatSvgCoordinate(bar_y)
       << "\" stroke=\"black\" stroke-width=\"2\"/><text x=\""
-      << Px(14 + bar * scale) << "\" y=\"" << Px(bar_y + 4) << "\">" << bar
-      << " " << XmlEscape(units) << "</text>"
-      << "<text x=\"" << Px(width - 10) << "\" y=\"" << Px(bar_y + 4)
+      << FormatSvgCoordinate(14 + bar * scale) << "\" y=\""
+      << FormatSvgCoordinate(bar_y + 4) << "\">" << bar << " "
+      << XmlEscape(units) << "</text>"
+      << "<text x=\"" << FormatSvgCoordinate(width - 10) << "\" y=\""
+      << FormatSvgCoordinate(bar_y + 4)
       << "\" text-anchor=\"end\"><tspan fill=\"" << kAxisColors[0]
       << "\">x</tspan> <tspan fill=\"" << kAxisColors[1]
       << "\">y</tspan> <tspan fill=\"" << kAxisColors[2]
