@@ -18,7 +18,9 @@ void PrintCameraModelLines(const CalibrationSummary& summary) {
               << std::right << " " << camera.camera.ModelName();
     if (report.validity) {
       std::cout << (report.validity->valid ? " valid" : " NOT valid")
-                << " over the whole image";
+                << (report.validity->fits_data
+                        ? " over the whole image"
+                        : " (does not follow the lens where there are data)");
       if (std::isfinite(report.validity->max_roundtrip_error_px)) {
         std::cout << " (round trip " << std::setprecision(2)
                   << report.validity->max_roundtrip_error_px << " px)";

@@ -25,6 +25,18 @@ Json ValidityJson(const ModelValidity& validity) {
                                ? FiniteOrNull(*validity.fold_angle_deg)
                                : Json(nullptr);
   node["corner_radius_px"] = FiniteOrNull(validity.corner_radius_px);
+  node["fits_data"] = validity.fits_data;
+  if (validity.residual_profile && validity.residual_profile->evaluated) {
+    Json rings = Json::array();
+    for (const RadialResidualRing& ring : validity.residual_profile->rings) {
+      rings.push_back({{"min_radius_px", FiniteOrNull(ring.min_radius_px)},
+                       {"max_radius_px", FiniteOrNull(ring.max_radius_px)},
+                       {"num_points", ring.num_points},
+                       {"mean_radial_px", FiniteOrNull(ring.mean_radial_px)},
+                       {"z", FiniteOrNull(ring.z)}});
+    }
+    node["radial_residual_rings"] = rings;
+  }
   node["suggested_model"] = validity.suggested_model.empty()
                                 ? Json(nullptr)
                                 : Json(validity.suggested_model);

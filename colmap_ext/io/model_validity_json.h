@@ -3,7 +3,10 @@
 // camera_model_report.h):
 //   "validity": {"valid", "monotonic", "max_roundtrip_error_px" (null if not
 //     finite), "fold_radius_px" (null: no fold), "fold_angle_deg",
-//     "corner_radius_px", "suggested_model" (null: none), "message"}
+//     "corner_radius_px", "fits_data" (the radial residual check),
+//     "radial_residual_rings" (when evaluated): [{"min_radius_px",
+//     "max_radius_px", "num_points", "mean_radial_px", "z"}],
+//     "suggested_model" (null: none), "message"}
 //   "model_choice" (cameras whose model was "auto" only): {"chosen",
 //     "reason", "candidates": [{"model", "valid", "heldout_rms_px",
 //     "train_rms_px", "num_params", "num_inliers", "chosen", "note"}]}

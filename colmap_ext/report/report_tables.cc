@@ -267,13 +267,14 @@ std::string ValidityTableHtml(const ReportJson& summary) {
   std::ostringstream html;
   html << "<table id=\"validity-table\"><tr><th>camera</th><th>model valid "
           "over the image</th><th>monotonic</th><th>undistort-distort "
-          "round trip (px)</th><th>fold radius (px)</th><th>corner radius "
+          "round trip (px)</th><th>fits the data (radial residual rings)"
+          "</th><th>fold radius (px)</th><th>corner radius "
           "(px)</th><th>suggested model</th><th>message</th></tr>\n";
   for (const ReportJson& camera : Cameras(summary)) {
     html << "<tr>" << Cell(Escape(TextAt(camera, "name")));
     const ReportJson* validity = FindKey(camera, "validity");
     if (validity == nullptr) {
-      html << "<td colspan=\"7\">"
+      html << "<td colspan=\"8\">"
            << NotComputedHtml("no \"validity\" in the summary")
            << "</td></tr>\n";
       continue;
@@ -286,6 +287,7 @@ std::string ValidityTableHtml(const ReportJson& summary) {
     const std::string suggested = TextAt(*validity, "suggested_model");
     html << Cell(yes_no("valid")) << Cell(yes_no("monotonic"))
          << Cell(FormatNumber(NumberAt(*validity, "max_roundtrip_error_px")))
+         << Cell(yes_no("fits_data"))
          << Cell(FormatNumber(NumberAt(*validity, "fold_radius_px")))
          << Cell(FormatNumber(NumberAt(*validity, "corner_radius_px")))
          << Cell(suggested.empty() ? "\u2013" : Escape(suggested))

@@ -13,6 +13,41 @@ CameraModelReport& CameraModelReportOf(const RigDataset& dataset,
   return report->camera_models[camera_index];
 }
 
+// The final inliers of camera `camera_index`, observed and projected through
+// the final calibration (refined map points where the map was refined).
+void FinalInlierPixels(const RigDataset& dataset,
+                       const RigCalibration& calibration,
+                       const int camera_index,
+                       std::vector<Eigen::Vector2d>* observed,
+                       std::vector<Eigen::Vector2d>* projected) {
+  const colmap::Camera& camera = calibration.cameras[camera_index];
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const RigImage& image = dataset.images[i];
+    const ImageResult& result = calibration.images[i];
+    if (image.camera_index != camera_index || !result.used ||
+        !calibration.rig_from_world[image.frameset_index]) {
+      continue;
+    }
+    const Rigid3d cam_from_world =
+        calibration.CamFromWorld(camera_index, image.frameset_index);
+    for (size_t k = 0;
+         k < image.correspondences.size() && k < result.inlier_mask.size();
+         ++k) {
+      if (!result.inlier_mask[k]) continue;
+      const Correspondence& correspondence = image.correspondences[k];
+      const auto refined =
+          calibration.refined_points3D.find(correspondence.point3D_id);
+      const Eigen::Vector3d point_cam =
+          cam_from_world * (refined != calibration.refined_points3D.end()
+                                ? refined->second
+                                : correspondence.point3D);
+      if (!(point_cam.z() > 0)) continue;
+      observed->push_back(correspondence.point2D);
+      projected->push_back(camera.WorldToImage(point_cam.hnormalized()));
+    }
+  }
+}
+
 }  // namespace
 
 bool UpgradeOrChooseCameraModel(
@@ -109,8 +144,22 @@ void CheckCameraModels(const PipelineOptions& options,
                        PipelineReport* report) {
   for (size_t c = 0; c < dataset.cameras.size(); ++c) {
     if (!calibration.camera_calibrated[c]) continue;
-    const ModelValidity validity = CheckModelValidity(
-        calibration.cameras[c], options.model_selection.validity);
+    const colmap::Camera& camera = calibration.cameras[c];
+    ModelValidity validity =
+        CheckModelValidity(camera, options.model_selection.validity);
+    std::vector<Eigen::Vector2d> observed, projected;
+    FinalInlierPixels(dataset, calibration, static_cast<int>(c), &observed,
+                      &projected);
+    const IntrinsicsRefinement& refinement = dataset.cameras[c].refinement;
+    AddResidualProfileCheck(
+        camera,
+        ComputeRadialResidualProfile(
+            Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
+            observed, projected,
+            options.model_selection.validity.residual_profile),
+        !refinement.focal_length || !refinement.principal_point ||
+            !refinement.extra_params,
+        &validity);
     CameraModelReportOf(dataset, static_cast<int>(c), report).validity =
         validity;
     if (!validity.valid) {

@@ -2,8 +2,10 @@
 // choice of a camera's model where it was "auto" (RigCamera::choose_model;
 // model_selection.h), in the camera upgrade of 1dr and, for the full-pose
 // methods, after the rig initialization; and the validity check of every
-// calibrated camera's final model (model_validity.h), an error diagnostic
-// "invalid_camera_model" for a model that is not valid over the whole image.
+// calibrated camera's final model (model_validity.h, with its final
+// inliers' radial residual profile), an error diagnostic
+// "invalid_camera_model" for a model that is not valid over the whole image
+// or does not follow the lens where there are data.
 #pragma once
 
 #include <optional>

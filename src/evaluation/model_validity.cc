@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace rig_calibrator {
@@ -126,7 +127,76 @@ std::string FormatNumber(double value, int precision) {
   return stream.str();
 }
 
+// Off-axis angle (degrees) of the pixel `radius_px` to the right of the
+// principal point, through the model's undistortion.
+double OffAxisAngleDeg(const colmap::Camera& camera, double radius_px) {
+  const Eigen::Vector2d pixel(camera.PrincipalPointX() + radius_px,
+                              camera.PrincipalPointY());
+  return colmap::RadToDeg(std::atan(camera.ImageToWorld(pixel).norm()));
+}
+
+// The next COLMAP model of the same kind with more distortion terms; empty
+// for the richest ones.
+std::string RicherCameraModel(const std::string& model) {
+  static const std::pair<const char*, const char*> kNext[] = {
+      {"SIMPLE_PINHOLE", "SIMPLE_RADIAL"},
+      {"PINHOLE", "OPENCV"},
+      {"SIMPLE_RADIAL", "RADIAL"},
+      {"RADIAL", "OPENCV"},
+      {"OPENCV", "FULL_OPENCV"},
+      {"SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE"},
+      {"RADIAL_FISHEYE", "OPENCV_FISHEYE"},
+      {"FOV", "OPENCV_FISHEYE"},
+      {"OPENCV_FISHEYE", "THIN_PRISM_FISHEYE"}};
+  for (const auto& [from, to] : kNext) {
+    if (model == from) return to;
+  }
+  return "";
+}
+
+// Off-axis angle beyond which a pinhole-type model's misfit is taken for a
+// wide lens (a diagonal field of view above 100 degrees): tan(theta) grows
+// faster than any few-term polynomial of the image radius follows.
+constexpr double kWideLensAngleDeg = 50;
+
 }  // namespace
+
+void AddResidualProfileCheck(const colmap::Camera& camera,
+                             const RadialResidualProfile& profile,
+                             const bool parameters_held,
+                             ModelValidity* validity) {
+  validity->residual_profile = profile;
+  validity->fits_data = !profile.systematic;
+  if (validity->fits_data) return;
+  const bool already_invalid = !validity->valid;
+  validity->valid = false;
+  if (already_invalid) return;
+  const double max_radius_px = profile.rings.back().max_radius_px;
+  const double max_angle_deg = OffAxisAngleDeg(camera, max_radius_px);
+  validity->suggested_model = !IsFisheyeCameraModel(camera.ModelId()) &&
+                                      !(max_angle_deg <= kWideLensAngleDeg)
+                                  ? "OPENCV_FISHEYE"
+                                  : RicherCameraModel(camera.ModelName());
+  std::string message =
+      "the fitted " + camera.ModelName() +
+      " model does not follow the lens: " + DescribeRadialMisfit(profile) +
+      ", where a model that fits leaves no such bias (its inliers reach " +
+      FormatNumber(max_radius_px, 0) + " px, " +
+      FormatNumber(max_angle_deg, 0) +
+      " deg off axis; the observations it cannot follow are rejected as "
+      "outliers and its projections beyond are extrapolated from a wrong "
+      "curve)";
+  if (parameters_held) {
+    message +=
+        ". Parameters are held at given values (--RigCalibrator.refine_*): "
+        "check them";
+  }
+  message += validity->suggested_model.empty()
+                 ? ". Try --RigCalibrator.camera_model auto."
+                 : ". Use " + validity->suggested_model +
+                       " or --RigCalibrator.camera_model auto.";
+  validity->message = message;
+}
 
 bool IsFisheyeCameraModel(const int model_id) {
   return model_id == colmap::SimpleRadialFisheyeCameraModel::kModelId ||

@@ -1,12 +1,15 @@
 // CheckModelValidity on exact models: valid pinhole-type and fisheye models,
 // a folding OPENCV (strong negative k2) and a folding OPENCV fitted to a
-// 150-degree fisheye lens.
+// 150-degree fisheye lens. AddResidualProfileCheck on residual profiles
+// with and without a systematic radial misfit: the verdict, the suggested
+// model by lens width and kind, and the message.
 #include "src/evaluation/model_validity.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <iostream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -132,6 +135,92 @@ TEST(ModelValidity, FoldingFisheyeModelIsInvalid) {
   EXPECT_NEAR(*validity.fold_radius_px, 200 * theta * (1 - 0.3 * theta * theta),
               0.5);
   EXPECT_TRUE(validity.suggested_model.empty());
+}
+
+// The radial residual profile of 2000 observations of `camera` uniform over
+// radii 5-300 px, observed with a radial bias of -0.6 px between 180 and
+// 240 px (`biased`) or none, in 0.5 px noise.
+RadialResidualProfile MakeProfile(const colmap::Camera& camera, bool biased) {
+  const Eigen::Vector2d pp(camera.PrincipalPointX(), camera.PrincipalPointY());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::normal_distribution<double> noise(0, 0.5);
+  std::vector<Eigen::Vector2d> observed, projected;
+  for (int k = 0; k < 2000; ++k) {
+    const double r = 5 + 295 * std::sqrt(unit(rng));
+    const double a = 2 * M_PI * unit(rng);
+    const Eigen::Vector2d direction(std::cos(a), std::sin(a));
+    const double bias = biased && r > 180 && r < 240 ? -0.6 : 0.0;
+    projected.push_back(pp + r * direction);
+    observed.push_back(projected.back() + bias * direction +
+                       Eigen::Vector2d(noise(rng), noise(rng)));
+  }
+  return ComputeRadialResidualProfile(pp, observed, projected);
+}
+
+TEST(ModelValidity, DataThatTheModelFitsKeepItValid) {
+  const colmap::Camera camera = MakeCamera(
+      "OPENCV", 640, 480, {420, 421, 332, 232, -0.30, 0.080, 4e-4, -3e-4});
+  ModelValidity validity = CheckModelValidity(camera);
+  AddResidualProfileCheck(camera, MakeProfile(camera, false), false, &validity);
+  Print("ring5 OPENCV, unbiased residuals", validity);
+  EXPECT_TRUE(validity.valid);
+  EXPECT_TRUE(validity.fits_data);
+  ASSERT_TRUE(validity.residual_profile.has_value());
+  EXPECT_TRUE(validity.residual_profile->evaluated);
+  EXPECT_TRUE(validity.suggested_model.empty());
+}
+
+TEST(ModelValidity, SystematicMisfitMakesTheModelInvalid) {
+  // OPENCV as fitted to fisheye_helmet5 (f 296 px, k2 > 0: no fold): the
+  // inliers' 300 px are 56 degrees off axis, a wide lens.
+  const colmap::Camera wide = MakeCamera(
+      "OPENCV", 640, 480, {295.8, 295.7, 325.8, 234.9, -0.233, 0.0405, 0, 0});
+  ModelValidity validity = CheckModelValidity(wide);
+  ASSERT_TRUE(validity.valid);
+  AddResidualProfileCheck(wide, MakeProfile(wide, true), false, &validity);
+  Print("OPENCV on a fisheye, biased residuals", validity);
+  EXPECT_FALSE(validity.valid);
+  EXPECT_FALSE(validity.fits_data);
+  EXPECT_TRUE(validity.monotonic);
+  EXPECT_EQ(validity.suggested_model, "OPENCV_FISHEYE");
+  EXPECT_NE(validity.message.find("does not follow the lens"),
+            std::string::npos);
+  EXPECT_NE(validity.message.find("inwards"), std::string::npos);
+  EXPECT_EQ(validity.message.find("refine_"), std::string::npos);
+
+  // A narrow lens (f 420 px: 300 px is 35 degrees off axis): the next model
+  // with more terms; with held parameters the message names them.
+  const colmap::Camera narrow = MakeCamera(
+      "OPENCV", 640, 480, {420, 421, 332, 232, -0.30, 0.080, 4e-4, -3e-4});
+  validity = CheckModelValidity(narrow);
+  AddResidualProfileCheck(narrow, MakeProfile(narrow, true), true, &validity);
+  Print("narrow OPENCV, biased residuals, parameters held", validity);
+  EXPECT_FALSE(validity.valid);
+  EXPECT_EQ(validity.suggested_model, "FULL_OPENCV");
+  EXPECT_NE(validity.message.find("--RigCalibrator.refine_*"),
+            std::string::npos);
+
+  // A fisheye model: the next fisheye model.
+  const colmap::Camera fisheye =
+      MakeCamera("RADIAL_FISHEYE", 640, 480, {300, 320, 240, 0.02, -0.003});
+  validity = CheckModelValidity(fisheye);
+  AddResidualProfileCheck(fisheye, MakeProfile(fisheye, true), false,
+                          &validity);
+  EXPECT_FALSE(validity.valid);
+  EXPECT_EQ(validity.suggested_model, "OPENCV_FISHEYE");
+}
+
+TEST(ModelValidity, FoldStaysTheReasonWhenTheModelAlsoMisfits) {
+  const colmap::Camera camera =
+      MakeCamera("OPENCV", 640, 480, {500, 500, 320, 240, 0, -0.5, 0, 0});
+  ModelValidity validity = CheckModelValidity(camera);
+  const std::string fold_message = validity.message;
+  AddResidualProfileCheck(camera, MakeProfile(camera, true), false, &validity);
+  EXPECT_FALSE(validity.valid);
+  EXPECT_FALSE(validity.fits_data);
+  EXPECT_EQ(validity.message, fold_message);
+  EXPECT_EQ(validity.suggested_model, "OPENCV_FISHEYE");
 }
 
 }  // namespace
