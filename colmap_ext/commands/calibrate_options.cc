@@ -41,10 +41,10 @@ void AddRigCalibratorOptions(po::options_description* description,
             "known_refine need a frameset in which every camera is "
             "localized");
   AddOption(description, "RigCalibrator.camera_model", &o->camera_model,
-            "COLMAP camera model of every camera (e.g. OPENCV, "
-            "OPENCV_FISHEYE, FULL_OPENCV, RADIAL), or auto (chosen among "
-            "pinhole-type and fisheye models by held-out reprojection "
-            "error), or per camera: cam0:OPENCV,cam1:auto");
+            "auto (the default: chosen among pinhole-type and fisheye "
+            "models by held-out reprojection error), or the COLMAP camera "
+            "model of every camera (e.g. OPENCV, OPENCV_FISHEYE, "
+            "FULL_OPENCV, RADIAL), or per camera: cam0:OPENCV,cam1:auto");
   AddUnsetOption(description, "RigCalibrator.reference_camera",
                  &o->reference_camera,
                  "the camera whose frame is the rig frame (default: the "

@@ -23,7 +23,7 @@ struct CalibrateOptions {
   bool overwrite = false;
 
   std::string method = "1dr";
-  std::string camera_model = "OPENCV";
+  std::string camera_model = "auto";
   std::string reference_camera;
   std::string camera_prefixes;
   double timestamp_tolerance = 0;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <boost/algorithm/string.hpp>
+#include <iostream>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "colmap_ext/io/rig_reference_io.h"
@@ -180,6 +182,19 @@ bool SetIntrinsicsRefinement(
   for (size_t c = 0; c < dataset->cameras.size(); ++c) {
     RigCamera& camera = dataset->cameras[c];
     if (given[c]) {
+      // A held focal length or distortion belongs to the given model: an
+      // automatic choice takes it.
+      if (camera.choose_model && (!camera.refinement.focal_length ||
+                                  !camera.refinement.extra_params)) {
+        camera.choose_model = false;
+        camera.camera.InitializeWithName(
+            given[c]->ModelName(), camera.camera.MeanFocalLength(),
+            camera.camera.Width(), camera.camera.Height());
+        std::cout << "camera " << camera.name << ": model "
+                  << given[c]->ModelName() << " from " << sources[c]
+                  << " (its intrinsics are held), not chosen automatically"
+                  << std::endl;
+      }
       if (!CopyHeldParams(*given[c], sources[c], camera.refinement, camera.name,
                           &camera.camera, error)) {
         return false;

@@ -151,15 +151,25 @@ void CheckCameraModels(const PipelineOptions& options,
     FinalInlierPixels(dataset, calibration, static_cast<int>(c), &observed,
                       &projected);
     const IntrinsicsRefinement& refinement = dataset.cameras[c].refinement;
-    AddResidualProfileCheck(
-        camera,
-        ComputeRadialResidualProfile(
-            Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
-            observed, projected,
-            options.model_selection.validity.residual_profile),
-        !refinement.focal_length || !refinement.principal_point ||
-            !refinement.extra_params,
-        &validity);
+    const bool parameters_held = !refinement.focal_length ||
+                                 !refinement.principal_point ||
+                                 !refinement.extra_params;
+    const RadialResidualProfile profile = ComputeRadialResidualProfile(
+        Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
+        observed, projected, options.model_selection.validity.residual_profile);
+    AddResidualProfileCheck(camera, profile, parameters_held, &validity);
+    if (parameters_held && !validity.fits_data) {
+      AddDiagnostic(
+          report, Diagnostic::Level::kWarning, "held_intrinsics_misfit",
+          "camera " + dataset.cameras[c].name +
+              ": with intrinsics held at their given values "
+              "(--RigCalibrator.refine_* 0), " +
+              DescribeRadialMisfit(profile) +
+              ", where a model that fits leaves no such bias: the given "
+              "values (or the model) do not fit the data. Check them, or "
+              "let the calibration refine them.",
+          {static_cast<int>(c)});
+    }
     CameraModelReportOf(dataset, static_cast<int>(c), report).validity =
         validity;
     if (!validity.valid) {

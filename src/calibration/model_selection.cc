@@ -198,22 +198,14 @@ std::string Fixed(double value, int precision) {
   return stream.str();
 }
 
-}  // namespace
-
-bool SelectCameraModel(const ModelSelectionOptions& options,
-                       const CameraUpgradeOptions& upgrade_options,
-                       const std::vector<Eigen::Vector2d>& points2D,
-                       const std::vector<Eigen::Vector3d>& points_cam,
-                       const std::vector<int>& groups, colmap::Camera* camera,
-                       CameraUpgradeResult* result, ModelChoice* choice) {
-  *choice = ModelChoice();
-  *result = CameraUpgradeResult();
-  if (groups.size() != points2D.size() ||
-      points_cam.size() != points2D.size()) {
-    result->error_message = "one frameset per correspondence needed";
-    choice->reason = result->error_message;
-    return false;
-  }
+// SelectCameraModel on all the given rows.
+bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
+                             const CameraUpgradeOptions& upgrade_options,
+                             const std::vector<Eigen::Vector2d>& points2D,
+                             const std::vector<Eigen::Vector3d>& points_cam,
+                             const std::vector<int>& groups,
+                             colmap::Camera* camera,
+                             CameraUpgradeResult* result, ModelChoice* choice) {
   std::vector<CandidateFit> fits;
   for (const std::string& model : options.candidate_models) {
     ModelCandidate candidate;
@@ -347,6 +339,65 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
   }
   *camera = fits[chosen].camera;
   *result = fits[chosen].result;
+  return true;
+}
+
+}  // namespace
+
+bool SelectCameraModel(const ModelSelectionOptions& options,
+                       const CameraUpgradeOptions& upgrade_options,
+                       const std::vector<Eigen::Vector2d>& points2D,
+                       const std::vector<Eigen::Vector3d>& points_cam,
+                       const std::vector<int>& groups, colmap::Camera* camera,
+                       CameraUpgradeResult* result, ModelChoice* choice) {
+  *choice = ModelChoice();
+  *result = CameraUpgradeResult();
+  if (groups.size() != points2D.size() ||
+      points_cam.size() != points2D.size()) {
+    result->error_message = "one frameset per correspondence needed";
+    choice->reason = result->error_message;
+    return false;
+  }
+  if (points2D.size() <= static_cast<size_t>(options.max_num_fit_rows)) {
+    return SelectCameraModelOnRows(options, upgrade_options, points2D,
+                                   points_cam, groups, camera, result, choice);
+  }
+  // The candidates are compared on a fixed random subset; the winner is
+  // then fitted to every row, as a model given by hand would be.
+  const std::vector<int> subset =
+      EvaluationSubset(points2D, points_cam, options.max_num_fit_rows);
+  std::vector<Eigen::Vector2d> subset_points2D;
+  std::vector<Eigen::Vector3d> subset_points_cam;
+  std::vector<int> subset_groups;
+  for (const int row : subset) {
+    subset_points2D.push_back(points2D[row]);
+    subset_points_cam.push_back(points_cam[row]);
+    subset_groups.push_back(groups[row]);
+  }
+  colmap::Camera chosen_camera = *camera;
+  CameraUpgradeResult subset_result;
+  if (!SelectCameraModelOnRows(options, upgrade_options, subset_points2D,
+                               subset_points_cam, subset_groups, &chosen_camera,
+                               &subset_result, choice)) {
+    *result = subset_result;
+    return false;
+  }
+  chosen_camera.InitializeWithName(choice->chosen, camera->MeanFocalLength(),
+                                   camera->Width(), camera->Height());
+  chosen_camera.SetPrincipalPointX(camera->PrincipalPointX());
+  chosen_camera.SetPrincipalPointY(camera->PrincipalPointY());
+  if (!UpgradeCamera(upgrade_options, points2D, points_cam, &chosen_camera,
+                     result)) {
+    choice->reason += "; fitting it to all " + std::to_string(points2D.size()) +
+                      " correspondences failed: " + result->error_message;
+    return false;
+  }
+  choice->reason += " (candidates compared on " +
+                    std::to_string(subset.size()) + " of " +
+                    std::to_string(points2D.size()) +
+                    " correspondences drawn at random; the chosen model "
+                    "fitted to all of them)";
+  *camera = chosen_camera;
   return true;
 }
 

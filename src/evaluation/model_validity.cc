@@ -167,7 +167,9 @@ void AddResidualProfileCheck(const colmap::Camera& camera,
                              ModelValidity* validity) {
   validity->residual_profile = profile;
   validity->fits_data = !profile.systematic;
-  if (validity->fits_data) return;
+  // Held parameters (possibly wrong given values) leave the model family
+  // untested: the caller warns instead.
+  if (validity->fits_data || parameters_held) return;
   const bool already_invalid = !validity->valid;
   validity->valid = false;
   if (already_invalid) return;
@@ -186,11 +188,6 @@ void AddResidualProfileCheck(const colmap::Camera& camera,
       " deg off axis; the observations it cannot follow are rejected as "
       "outliers and its projections beyond are extrapolated from a wrong "
       "curve)";
-  if (parameters_held) {
-    message +=
-        ". Parameters are held at given values (--RigCalibrator.refine_*): "
-        "check them";
-  }
   message += validity->suggested_model.empty()
                  ? ". Try --RigCalibrator.camera_model auto."
                  : ". Use " + validity->suggested_model +

@@ -76,9 +76,9 @@ ModelValidity CheckModelValidity(
 // Check 3 on `profile`, the radial residual profile of the camera's final
 // inliers: a systematic misfit makes the model invalid, with its numbers in
 // the message (which stays the fold's if the model also folds) and a
-// suggested model. `parameters_held`: some intrinsics were held at given
-// values (--RigCalibrator.refine_*), which the message then names as a
-// possible cause.
+// suggested model. With `parameters_held` (some intrinsics held at given
+// values, --RigCalibrator.refine_*) a misfit may be the given values' and
+// says nothing of the model family: fits_data is set, the verdict is left.
 void AddResidualProfileCheck(const colmap::Camera& camera,
                              const RadialResidualProfile& profile,
                              bool parameters_held, ModelValidity* validity);
