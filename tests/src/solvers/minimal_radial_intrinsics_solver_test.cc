@@ -103,7 +103,7 @@ void ExpectEveryInstanceSolved(const Case& c) {
     const std::vector<RadialIntrinsics> solutions =
         SolveMinimalRadialIntrinsics(instance.scene.x,
                                      instance.scene.points_cam, c.profile,
-                                     c.num_terms);
+                                     c.num_terms, std::nullopt);
     EXPECT_LE(solutions.size(), c.max_num_solutions) << "seed " << seed;
     max_num_solutions = std::max(max_num_solutions, solutions.size());
     double best_error = std::numeric_limits<double>::infinity();
@@ -196,7 +196,8 @@ std::vector<double> BruteForceSolutionTzs(const Instance& instance,
     model.num_radial_terms = num_terms;
     model.tz = tz_of((lo + hi) / 2);
     double squared_error = 0;
-    if (FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error) &&
+    if (FitRadialProfile(scene.x, scene.points_cam, std::nullopt, &model,
+                         &squared_error) &&
         RadiusGrowsOverPoints(scene.x, scene.points_cam, model)) {
       tzs.push_back(model.tz);
     }
@@ -217,7 +218,7 @@ TEST(SolveMinimalRadialIntrinsics, FindsEverySolution) {
         const std::vector<RadialIntrinsics> solutions =
             SolveMinimalRadialIntrinsics(instance.scene.x,
                                          instance.scene.points_cam, profile,
-                                         num_terms);
+                                         num_terms, std::nullopt);
         for (const double tz :
              BruteForceSolutionTzs(instance, profile, num_terms)) {
           ++num_solutions;
@@ -245,16 +246,16 @@ TEST(SolveMinimalRadialIntrinsics, RejectsMirroringProfiles) {
     for (int num_terms = 0; num_terms <= 2; ++num_terms) {
       for (int seed = 0; seed < 50; ++seed) {
         Instance instance = MakeInstance(profile, num_terms, seed);
-        EXPECT_FALSE(SolveMinimalRadialIntrinsics(instance.scene.x,
-                                                  instance.scene.points_cam,
-                                                  profile, num_terms)
+        EXPECT_FALSE(SolveMinimalRadialIntrinsics(
+                         instance.scene.x, instance.scene.points_cam, profile,
+                         num_terms, std::nullopt)
                          .empty());
         for (Eigen::Vector3d& point : instance.scene.points_cam) {
           point.head<2>() *= -1;
         }
-        EXPECT_TRUE(SolveMinimalRadialIntrinsics(instance.scene.x,
-                                                 instance.scene.points_cam,
-                                                 profile, num_terms)
+        EXPECT_TRUE(SolveMinimalRadialIntrinsics(
+                        instance.scene.x, instance.scene.points_cam, profile,
+                        num_terms, std::nullopt)
                         .empty())
             << CaseName({profile, num_terms, 0}) << " seed " << seed;
       }
@@ -267,15 +268,15 @@ TEST(SolveMinimalRadialIntrinsics, RejectsBadInput) {
   const std::vector<Eigen::Vector2d>& x = instance.scene.x;
   const std::vector<Eigen::Vector3d>& points_cam = instance.scene.points_cam;
   // Not the minimal number of points for the number of terms.
-  EXPECT_TRUE(
-      SolveMinimalRadialIntrinsics(x, points_cam, RadialProfile::kPolynomial, 1)
-          .empty());
-  EXPECT_TRUE(
-      SolveMinimalRadialIntrinsics(x, points_cam, RadialProfile::kPolynomial, 3)
-          .empty());
+  EXPECT_TRUE(SolveMinimalRadialIntrinsics(
+                  x, points_cam, RadialProfile::kPolynomial, 1, std::nullopt)
+                  .empty());
+  EXPECT_TRUE(SolveMinimalRadialIntrinsics(
+                  x, points_cam, RadialProfile::kPolynomial, 3, std::nullopt)
+                  .empty());
   EXPECT_TRUE(SolveMinimalRadialIntrinsics(
                   x, {points_cam.begin(), points_cam.end() - 1},
-                  RadialProfile::kPolynomial, 2)
+                  RadialProfile::kPolynomial, 2, std::nullopt)
                   .empty());
   // Non-finite values and every pixel on the principal point.
   std::vector<Eigen::Vector3d> not_finite = points_cam;
@@ -284,9 +285,11 @@ TEST(SolveMinimalRadialIntrinsics, RejectsBadInput) {
   for (const RadialProfile profile :
        {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
     EXPECT_TRUE(
-        SolveMinimalRadialIntrinsics(x, not_finite, profile, 2).empty());
-    EXPECT_TRUE(
-        SolveMinimalRadialIntrinsics(centered, points_cam, profile, 2).empty());
+        SolveMinimalRadialIntrinsics(x, not_finite, profile, 2, std::nullopt)
+            .empty());
+    EXPECT_TRUE(SolveMinimalRadialIntrinsics(centered, points_cam, profile, 2,
+                                             std::nullopt)
+                    .empty());
   }
 }
 

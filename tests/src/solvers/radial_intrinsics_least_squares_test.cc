@@ -38,7 +38,7 @@ TEST(SolveRadialIntrinsicsLeastSquares, ExactData) {
           MakeRadialIntrinsicsScene(truth, 200, MaxAngleDeg(profile), 20);
       const std::vector<RadialIntrinsics> models =
           SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile,
-                                            num_terms);
+                                            num_terms, std::nullopt);
       ASSERT_FALSE(models.empty());
       EXPECT_LE(models.size(), 3);
       EXPECT_LT(RelativeError(models[0], truth, 1), 1e-8);
@@ -59,8 +59,8 @@ TEST(SolveRadialIntrinsicsLeastSquares, NoisyData) {
         MakeRadialIntrinsicsScene(truth, 500, MaxAngleDeg(profile), 7);
     testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
     const std::vector<RadialIntrinsics> models =
-        SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile,
-                                          2);
+        SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile, 2,
+                                          std::nullopt);
     ASSERT_FALSE(models.empty());
     EXPECT_NEAR(models[0].focal, truth.focal, 0.001 * truth.focal);
     EXPECT_NEAR(models[0].tz, truth.tz, 0.002);
@@ -77,11 +77,12 @@ TEST(SolveRadialIntrinsicsLeastSquares, RejectsMirroringProfiles) {
     point.head<2>() *= -1;
   }
   EXPECT_TRUE(SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam,
-                                                RadialProfile::kPolynomial, 2)
+                                                RadialProfile::kPolynomial, 2,
+                                                std::nullopt)
                   .empty());
-  EXPECT_TRUE(
-      SolveRadialIntrinsicsLeastSquares({}, {}, RadialProfile::kPolynomial, 2)
-          .empty());
+  EXPECT_TRUE(SolveRadialIntrinsicsLeastSquares(
+                  {}, {}, RadialProfile::kPolynomial, 2, std::nullopt)
+                  .empty());
 }
 
 }  // namespace

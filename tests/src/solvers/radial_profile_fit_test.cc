@@ -31,19 +31,19 @@ TEST(FitRadialProfile, ExactAtTheTrueTz) {
     model.focal = 1;
     model.k[0] = model.k[1] = 0;
     double squared_error = -1;
-    ASSERT_TRUE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &model, &squared_error));
     EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
     EXPECT_LT(squared_error, 1e-16);
     // Any other tz fits worse.
     model.tz = truth.tz + 0.1;
-    ASSERT_TRUE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &model, &squared_error));
     EXPECT_GT(squared_error, 1);
     // Points behind the camera.
     model.tz = -100;
-    EXPECT_FALSE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    EXPECT_FALSE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                  &model, &squared_error));
   }
 }
 
@@ -56,13 +56,13 @@ TEST(FitRadialProfile, OnlyTheRequestedTerms) {
   RadialIntrinsics model = truth;
   model.num_radial_terms = 1;
   double squared_error = 0;
-  ASSERT_TRUE(
-      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt, &model,
+                               &squared_error));
   EXPECT_EQ(model.k[1], 0);
   EXPECT_GT(squared_error, 1);
   model.num_radial_terms = 3;
-  EXPECT_FALSE(
-      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  EXPECT_FALSE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt, &model,
+                                &squared_error));
 }
 
 // From tz 0.3 m off the truth, Gauss-Newton reaches the truth on exact data
@@ -76,20 +76,20 @@ TEST(RefineRadialProfileAndTz, ConvergesFromAWrongTz) {
     RadialIntrinsics model = truth;
     model.tz += 0.3;
     double squared_error = -1;
-    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
-                                         &squared_error));
+    ASSERT_TRUE(RefineRadialProfileAndTz(
+        scene.x, scene.points_cam, std::nullopt, 10, &model, &squared_error));
     EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
     EXPECT_LT(squared_error, 1e-16);
 
     testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
     RadialIntrinsics at_truth = truth;
     double error_at_truth = 0;
-    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, &at_truth,
-                                 &error_at_truth));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &at_truth, &error_at_truth));
     model = truth;
     model.tz += 0.3;
-    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
-                                         &squared_error));
+    ASSERT_TRUE(RefineRadialProfileAndTz(
+        scene.x, scene.points_cam, std::nullopt, 10, &model, &squared_error));
     EXPECT_LT(squared_error, error_at_truth);
     EXPECT_NEAR(model.tz, truth.tz, 0.05);
     EXPECT_NEAR(model.focal, truth.focal, 0.01 * truth.focal);
