@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include "src/estimators/radial_intrinsics_estimator.h"
@@ -54,6 +55,13 @@ bool InitializationForModel(const int model_id, Initialization* init) {
     default:
       return false;
   }
+}
+
+// Correspondences the RANSAC's local optimization needs: one more than the
+// minimal sample, n + 2 unknowns (tz, f, k1..kn) or n + 1 with f known.
+size_t MinNumPoints(const Initialization& init,
+                    const std::optional<double>& known_focal) {
+  return init.num_radial_terms + (known_focal ? 2 : 3);
 }
 
 // Full reprojection residual of one correspondence:
@@ -480,9 +488,11 @@ std::string CheckInput(const CameraUpgradeOptions& options,
 }
 
 // Step 1 on at most max_num_ransac_points of the valid correspondences, drawn
-// with a fixed seed, with pixels relative to the principal point.
+// with a fixed seed, with pixels relative to the principal point; with
+// `known_focal` (a held focal length) every hypothesis has that f.
 bool EstimateInitialization(const CameraUpgradeOptions& options,
                             const Initialization& init,
+                            const std::optional<double>& known_focal,
                             const std::vector<Eigen::Vector2d>& points2D,
                             const std::vector<Eigen::Vector3d>& points_cam,
                             const Eigen::Vector2d& principal_point,
@@ -505,11 +515,15 @@ bool EstimateInitialization(const CameraUpgradeOptions& options,
   ransac_options.min_num_trials = options.min_num_trials;
   ransac_options.max_num_trials = options.max_num_trials;
   if (!EstimateRadialIntrinsicsRansac(ransac_options, init.profile,
-                                      init.num_radial_terms, ransac_x,
-                                      ransac_points_cam, initial)) {
-    *error = "no initial tz and focal length consistent with " +
-             std::to_string(init.num_radial_terms + 3) + " or more of the " +
-             std::to_string(valid_idxs.size()) + " correspondences";
+                                      init.num_radial_terms, known_focal,
+                                      ransac_x, ransac_points_cam, initial)) {
+    *error = std::string(known_focal ? "no initial tz for the held focal "
+                                       "length consistent with "
+                                     : "no initial tz and focal length "
+                                       "consistent with ") +
+             std::to_string(MinNumPoints(init, known_focal)) +
+             " or more of the " + std::to_string(valid_idxs.size()) +
+             " correspondences";
     return false;
   }
   return true;
@@ -539,24 +553,6 @@ std::vector<double> InitialParams(const CameraUpgradeOptions& options,
     }
   }
   return params;
-}
-
-// The LM's starting tz for a held focal length f_given: the RANSAC's
-// (f, tz) fit the image scale f / (c + tz) of the points, so with d the
-// median inlier depth c + tz of the RANSAC,
-//   tz' = (f_given / f) d - (d - tz)
-// keeps that scale at the median inlier.
-double InitialTzForHeldFocal(const RadialIntrinsics& initial,
-                             const double given_focal,
-                             const std::vector<Eigen::Vector3d>& points_cam,
-                             const std::vector<char>& inlier_mask) {
-  std::vector<double> depths;
-  for (size_t i = 0; i < points_cam.size(); ++i) {
-    if (inlier_mask[i]) depths.push_back(points_cam[i].z() + initial.tz);
-  }
-  if (depths.empty() || !(initial.focal > 0)) return initial.tz;
-  const double depth = colmap::Median(depths);
-  return given_focal / initial.focal * depth - (depth - initial.tz);
 }
 
 bool Fail(const std::string& message, CameraUpgradeResult* result) {
@@ -599,7 +595,13 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
       valid_idxs.push_back(i);
     }
   }
-  const size_t min_num_points = init.num_radial_terms + 3;
+  // The RANSAC's hypotheses have the held focal length (its mean for
+  // PINHOLE-type models with two).
+  const std::optional<double> known_focal =
+      options.refine_focal_length
+          ? std::nullopt
+          : std::optional<double>(camera->MeanFocalLength());
+  const size_t min_num_points = MinNumPoints(init, known_focal);
   if (valid_idxs.size() < min_num_points) {
     return Fail(std::to_string(valid_idxs.size()) +
                     " valid correspondences, need at least " +
@@ -608,7 +610,7 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
   }
 
   RadialIntrinsics initial;
-  if (!EstimateInitialization(options, init, points2D, points_cam,
+  if (!EstimateInitialization(options, init, known_focal, points2D, points_cam,
                               principal_point, valid_idxs, &initial,
                               &result->error_message)) {
     return Fail(result->error_message, result);
@@ -625,10 +627,7 @@ bool UpgradeCamera(const CameraUpgradeOptions& options,
 
   std::vector<double> params =
       InitialParams(options, *camera, init, initial, principal_point);
-  double tz = options.refine_focal_length
-                  ? initial.tz
-                  : InitialTzForHeldFocal(initial, camera->MeanFocalLength(),
-                                          points_cam, result->inlier_mask);
+  double tz = initial.tz;
   if (!RefineUpgradeForModel(camera->ModelId(), options, points2D, points_cam,
                              valid, &tz, &params, result)) {
     result->tz = 0;

@@ -9,8 +9,9 @@
 //     the fisheye ones) with f and the first two radial terms: hypotheses
 //     from the minimal solver (SolveMinimalRadialIntrinsics, closed form),
 //     local optimization by variable projection over tz
-//     (SolveRadialIntrinsicsLeastSquares). Residual: full reprojection
-//     error, principal point fixed at the input estimate.
+//     (SolveRadialIntrinsicsLeastSquares). With the focal length held, both
+//     take it as known (tz and the radial terms only). Residual: full
+//     reprojection error, principal point fixed at the input estimate.
 //  2. Conversion to the model's parameters: fx = fy = f, k1, k2 where the
 //     model has them, every other distortion term 0.
 //  3. Levenberg-Marquardt (Ceres, Cauchy loss) over tz and all parameters of
@@ -45,11 +46,11 @@ struct CameraUpgradeOptions {
   int max_num_iterations = 100;
   // COLMAP's refine_* switches (intrinsics_refinement.h): a parameter not
   // refined keeps the input camera's value. With the focal length held the
-  // RANSAC still draws (tz, f, k) hypotheses to find the inliers; the start
-  // of the LM takes the given f with tz scaled to keep the median inlier's
-  // image scale f / depth, and the LM estimates tz and the distortion.
-  // With the extra parameters held, the LM starts from and keeps the given
-  // distortion.
+  // RANSAC's minimal solver, its local optimization and their polish all use
+  // the given f (its mean fx, fy for a model with two), so the inliers, tz
+  // and the distortion that start the LM are those of that f, and the LM
+  // estimates tz and the distortion. With the extra parameters held, the LM
+  // starts from and keeps the given distortion.
   bool refine_principal_point = true;
   bool refine_focal_length = true;
   bool refine_extra_params = true;

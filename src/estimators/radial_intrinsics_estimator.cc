@@ -2,6 +2,7 @@
 
 #include <colmap/optim/loransac.h>
 
+#include <cmath>
 #include <limits>
 
 #include "src/estimators/seeded_random_sampler.h"
@@ -14,24 +15,44 @@ namespace {
 // so the largest finite double marks an outlier without producing inf/NaN.
 constexpr double kInvalidResidual = std::numeric_limits<double>::max();
 
-template <int kNumRadialTerms>
+template <int kNumRadialTerms, bool kKnownFocal>
 bool RunRansac(const colmap::RANSACOptions& options,
-               const RadialProfile profile,
+               const RadialProfile profile, const double known_focal,
                const std::vector<Eigen::Vector2d>& x,
                const std::vector<Eigen::Vector3d>& points_cam,
                RadialIntrinsics* model) {
-  colmap::LORANSAC<RadialIntrinsicsEstimator<kNumRadialTerms>,
-                   RadialIntrinsicsLocalEstimator<kNumRadialTerms>,
+  colmap::LORANSAC<RadialIntrinsicsEstimator<kNumRadialTerms, kKnownFocal>,
+                   RadialIntrinsicsLocalEstimator<kNumRadialTerms, kKnownFocal>,
                    colmap::InlierSupportMeasurer, SeededRandomSampler>
       ransac(options);
   ransac.estimator.profile = profile;
   ransac.local_estimator.profile = profile;
+  ransac.estimator.known_focal = known_focal;
+  ransac.local_estimator.known_focal = known_focal;
   const auto report = ransac.Estimate(x, points_cam);
   if (!report.success) {
     return false;
   }
   *model = report.model;
   return true;
+}
+
+template <int kNumRadialTerms>
+bool RunRansac(const colmap::RANSACOptions& options,
+               const RadialProfile profile,
+               const std::optional<double>& known_focal,
+               const std::vector<Eigen::Vector2d>& x,
+               const std::vector<Eigen::Vector3d>& points_cam,
+               RadialIntrinsics* model) {
+  if (!known_focal) {
+    return RunRansac<kNumRadialTerms, false>(options, profile, 0, x, points_cam,
+                                             model);
+  }
+  if (!(std::isfinite(*known_focal) && *known_focal > 0)) {
+    return false;
+  }
+  return RunRansac<kNumRadialTerms, true>(options, profile, *known_focal, x,
+                                          points_cam, model);
 }
 
 }  // namespace
@@ -51,15 +72,16 @@ void RadialIntrinsicsResiduals(const std::vector<Eigen::Vector2d>& x,
 
 bool EstimateRadialIntrinsicsRansac(
     const colmap::RANSACOptions& options, const RadialProfile profile,
-    const int num_radial_terms, const std::vector<Eigen::Vector2d>& x,
+    const int num_radial_terms, const std::optional<double>& known_focal,
+    const std::vector<Eigen::Vector2d>& x,
     const std::vector<Eigen::Vector3d>& points_cam, RadialIntrinsics* model) {
   switch (num_radial_terms) {
     case 0:
-      return RunRansac<0>(options, profile, x, points_cam, model);
+      return RunRansac<0>(options, profile, known_focal, x, points_cam, model);
     case 1:
-      return RunRansac<1>(options, profile, x, points_cam, model);
+      return RunRansac<1>(options, profile, known_focal, x, points_cam, model);
     case 2:
-      return RunRansac<2>(options, profile, x, points_cam, model);
+      return RunRansac<2>(options, profile, known_focal, x, points_cam, model);
     default:
       return false;
   }

@@ -9,6 +9,7 @@
 #include <colmap/optim/ransac.h>
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "src/solvers/minimal_radial_intrinsics_solver.h"
@@ -25,8 +26,11 @@ void RadialIntrinsicsResiduals(const std::vector<Eigen::Vector2d>& x,
                                const RadialIntrinsics& model,
                                std::vector<double>* residuals);
 
-// What both estimators share: the types, the profile and the residuals.
-template <int kNumRadialTerms>
+// What both estimators share: the types, the profile, the known focal
+// length and the residuals. kKnownFocal: the hypotheses have the focal
+// length `known_focal` (the user holds it), so the minimal sample is one
+// correspondence smaller.
+template <int kNumRadialTerms, bool kKnownFocal>
 class RadialIntrinsicsEstimatorBase {
  public:
   typedef Eigen::Vector2d X_t;  // pixel relative to the principal point
@@ -37,55 +41,66 @@ class RadialIntrinsicsEstimatorBase {
                 "0 to 2 radial terms");
 
   RadialProfile profile = RadialProfile::kPolynomial;
+  double known_focal = 0;  // in pixels, > 0; used only if kKnownFocal
 
   void Residuals(const std::vector<X_t>& x, const std::vector<Y_t>& points_cam,
                  const M_t& model, std::vector<double>* residuals) const {
     RadialIntrinsicsResiduals(x, points_cam, model, residuals);
   }
+
+ protected:
+  std::optional<double> KnownFocal() const {
+    return kKnownFocal ? std::optional<double>(known_focal) : std::nullopt;
+  }
 };
 
 // Minimal estimator: SolveMinimalRadialIntrinsics on kNumRadialTerms + 2
-// correspondences (f, the radial terms and tz).
-template <int kNumRadialTerms>
+// correspondences (f, the radial terms and tz), kNumRadialTerms + 1 with a
+// known focal length (the radial terms and tz).
+template <int kNumRadialTerms, bool kKnownFocal = false>
 class RadialIntrinsicsEstimator
-    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms> {
+    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms, kKnownFocal> {
  public:
-  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms>;
-  static constexpr int kMinNumSamples = kNumRadialTerms + 2;
+  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms, kKnownFocal>;
+  static constexpr int kMinNumSamples = kNumRadialTerms + (kKnownFocal ? 1 : 2);
 
   std::vector<RadialIntrinsics> Estimate(
       const std::vector<Eigen::Vector2d>& x,
       const std::vector<Eigen::Vector3d>& points_cam) const {
     return SolveMinimalRadialIntrinsics(x, points_cam, Base::profile,
-                                        kNumRadialTerms);
+                                        kNumRadialTerms, Base::KnownFocal());
   }
 };
 
 // Local (non-minimal) estimator: SolveRadialIntrinsicsLeastSquares on all
 // given correspondences (the current inliers), at least one more than the
 // minimal sample.
-template <int kNumRadialTerms>
+template <int kNumRadialTerms, bool kKnownFocal = false>
 class RadialIntrinsicsLocalEstimator
-    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms> {
+    : public RadialIntrinsicsEstimatorBase<kNumRadialTerms, kKnownFocal> {
  public:
-  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms>;
-  static constexpr int kMinNumSamples = kNumRadialTerms + 3;
+  using Base = RadialIntrinsicsEstimatorBase<kNumRadialTerms, kKnownFocal>;
+  static constexpr int kMinNumSamples =
+      RadialIntrinsicsEstimator<kNumRadialTerms, kKnownFocal>::kMinNumSamples +
+      1;
 
   std::vector<RadialIntrinsics> Estimate(
       const std::vector<Eigen::Vector2d>& x,
       const std::vector<Eigen::Vector3d>& points_cam) const {
-    return SolveRadialIntrinsicsLeastSquares(x, points_cam, Base::profile,
-                                             kNumRadialTerms);
+    return SolveRadialIntrinsicsLeastSquares(
+        x, points_cam, Base::profile, kNumRadialTerms, Base::KnownFocal());
   }
 };
 
 // The upgrade's initialization (paper §3.5): COLMAP's LORANSAC with the two
 // estimators above for `num_radial_terms` (0..2), inlier-count support and
-// SeededRandomSampler, so that the result depends only on the input. False if
-// no model is found.
+// SeededRandomSampler, so that the result depends only on the input. With
+// `known_focal` (> 0) every hypothesis and the result have that focal length
+// exactly. False if no model is found.
 bool EstimateRadialIntrinsicsRansac(
     const colmap::RANSACOptions& options, RadialProfile profile,
-    int num_radial_terms, const std::vector<Eigen::Vector2d>& x,
+    int num_radial_terms, const std::optional<double>& known_focal,
+    const std::vector<Eigen::Vector2d>& x,
     const std::vector<Eigen::Vector3d>& points_cam, RadialIntrinsics* model);
 
 }  // namespace rig_calibrator

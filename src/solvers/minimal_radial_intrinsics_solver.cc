@@ -37,15 +37,18 @@ constexpr double kRelativeDuplicateTz = 1e-9;
 
 // The sample in scaled form: rho~ = rho / sigma (sigma = RMS of rho),
 // s~ = s / L, e = (c - mean(c)) / L, so that d = c + tz = L (e + v) with
-// v = (tz + mean(c)) / L; phi is unchanged by the scaling.
+// v = (tz + mean(c)) / L; phi is unchanged by the scaling, and a known f
+// becomes f~ = f / sigma (f phi - rho = sigma (f~ phi - rho~)).
 struct ScaledSample {
   std::vector<double> rho, s, e;
   double sigma = 0, length = 0, mean_c = 0;
-  double min_v = 0;  // every depth is positive for v > min_v
+  double min_v = 0;             // every depth is positive for v > min_v
+  std::optional<double> focal;  // f~ when f is known
 };
 
 bool MakeScaledSample(const std::vector<Eigen::Vector2d>& x,
                       const std::vector<Eigen::Vector3d>& points_cam,
+                      const std::optional<double>& known_focal,
                       ScaledSample* sample) {
   const int m = static_cast<int>(x.size());
   double sum_squared_rho = 0, sum_squared_length = 0;
@@ -74,6 +77,9 @@ bool MakeScaledSample(const std::vector<Eigen::Vector2d>& x,
     sample->s[i] /= sample->length;
     sample->e[i] /= sample->length;
     sample->min_v = std::max(sample->min_v, -sample->e[i]);
+  }
+  if (known_focal) {
+    sample->focal = *known_focal / sample->sigma;
   }
   return true;
 }
@@ -133,11 +139,12 @@ Polynomial Determinant(const std::vector<std::vector<Polynomial>>& matrix) {
 // Roots v > min_v of the polynomial profile's det M'(v), where row i of M' is
 // row i of M times d_i^(2n+1) in scaled units:
 //   [s_i (e_i + v)^(2n), s_i^3 (e_i + v)^(2n-2), .., s_i^(2n+1),
-//    -rho_i (e_i + v)^(2n+1)].
+//    -rho_i (e_i + v)^(2n+1)],
+// with a known f its first entry times f~ added to the last, then dropped.
 std::vector<double> PolynomialProfileRoots(const ScaledSample& sample,
                                            const int num_radial_terms) {
   const int n = num_radial_terms;
-  const int size = n + 2;
+  const int size = static_cast<int>(sample.rho.size());
   std::vector<std::vector<Polynomial>> matrix(size);
   for (int i = 0; i < size; ++i) {
     for (int j = 0; j <= n; ++j) {
@@ -146,6 +153,10 @@ std::vector<double> PolynomialProfileRoots(const ScaledSample& sample,
     }
     matrix[i].push_back(
         ScaledPowerOfShift(-sample.rho[i], sample.e[i], 2 * n + 1));
+    if (sample.focal) {
+      AddScaled(matrix[i].front(), *sample.focal, &matrix[i].back());
+      matrix[i].erase(matrix[i].begin());
+    }
   }
   const Polynomial determinant = Determinant(matrix);
   Eigen::VectorXd coeffs(determinant.size());
@@ -169,11 +180,13 @@ std::vector<double> PolynomialProfileRoots(const ScaledSample& sample,
 }
 
 // det M(v) of the equidistant profile, M's rows [phi_i, phi_i^3, ..,
-// phi_i^(2n+1), -rho_i] with phi_i = atan2(s_i, e_i + v).
+// phi_i^(2n+1), -rho_i] with phi_i = atan2(s_i, e_i + v); with a known f
+// [phi_i^3, .., phi_i^(2n+1), f~ phi_i - rho_i].
 double EquidistantDeterminant(const ScaledSample& sample,
                               const int num_radial_terms, const double v) {
-  const int size = num_radial_terms + 2;
-  Eigen::MatrixXd M(size, size);
+  const int size = static_cast<int>(sample.rho.size());
+  const int num_columns = num_radial_terms + 2;
+  Eigen::MatrixXd M(size, num_columns);
   for (int i = 0; i < size; ++i) {
     const double phi = std::atan2(sample.s[i], sample.e[i] + v);
     double phi_power = phi;
@@ -181,9 +194,12 @@ double EquidistantDeterminant(const ScaledSample& sample,
       M(i, j) = phi_power;
       phi_power *= phi * phi;
     }
-    M(i, size - 1) = -sample.rho[i];
+    M(i, num_columns - 1) = -sample.rho[i];
   }
-  return M.determinant();
+  if (sample.focal) {
+    M.col(num_columns - 1) += *sample.focal * M.col(0);
+  }
+  return M.rightCols(size).determinant();
 }
 
 // Roots of the equidistant profile's det M(v), bracketed by the sign scan of
@@ -245,12 +261,13 @@ std::vector<double> EquidistantProfileRoots(const ScaledSample& sample,
 std::vector<RadialIntrinsics> SolveMinimalRadialIntrinsics(
     const std::vector<Eigen::Vector2d>& x,
     const std::vector<Eigen::Vector3d>& points_cam, const RadialProfile profile,
-    const int num_radial_terms) {
+    const int num_radial_terms, const std::optional<double>& known_focal) {
   ScaledSample sample;
+  const size_t num_unknowns = num_radial_terms + (known_focal ? 1 : 2);
   if (num_radial_terms < 0 || num_radial_terms > 2 ||
-      x.size() != static_cast<size_t>(num_radial_terms + 2) ||
-      points_cam.size() != x.size() ||
-      !MakeScaledSample(x, points_cam, &sample)) {
+      x.size() != num_unknowns || points_cam.size() != x.size() ||
+      (known_focal && !(std::isfinite(*known_focal) && *known_focal > 0)) ||
+      !MakeScaledSample(x, points_cam, known_focal, &sample)) {
     return {};
   }
   const std::vector<double> roots =
@@ -267,7 +284,8 @@ std::vector<RadialIntrinsics> SolveMinimalRadialIntrinsics(
     model.num_radial_terms = num_radial_terms;
     model.tz = v * sample.length - sample.mean_c;
     double squared_error = 0;
-    if (RefineRadialProfileAndTz(x, points_cam, kMaxNumPolishIterations, &model,
+    if (RefineRadialProfileAndTz(x, points_cam, known_focal,
+                                 kMaxNumPolishIterations, &model,
                                  &squared_error) &&
         squared_error <= max_squared_error &&
         RadiusGrowsOverPoints(x, points_cam, model)) {

@@ -33,10 +33,11 @@ constexpr int kMaxNumPolishIterations = 5;
 // E(tz) of the variable projection; infinite where FitRadialProfile fails.
 double ProfileError(const std::vector<Eigen::Vector2d>& x,
                     const std::vector<Eigen::Vector3d>& points_cam,
+                    const std::optional<double>& known_focal,
                     RadialIntrinsics model, const double tz) {
   model.tz = tz;
   double squared_error = 0;
-  if (!FitRadialProfile(x, points_cam, &model, &squared_error)) {
+  if (!FitRadialProfile(x, points_cam, known_focal, &model, &squared_error)) {
     return std::numeric_limits<double>::infinity();
   }
   return squared_error;
@@ -69,7 +70,7 @@ double ReferenceNearestDepth(const std::vector<Eigen::Vector2d>& x,
 std::vector<RadialIntrinsics> SolveRadialIntrinsicsLeastSquares(
     const std::vector<Eigen::Vector2d>& x,
     const std::vector<Eigen::Vector3d>& points_cam, const RadialProfile profile,
-    const int num_radial_terms) {
+    const int num_radial_terms, const std::optional<double>& known_focal) {
   if (x.empty() || x.size() != points_cam.size()) {
     return {};
   }
@@ -92,7 +93,8 @@ std::vector<RadialIntrinsics> SolveRadialIntrinsicsLeastSquares(
     return tz_bound + u0 * std::pow(kGridRange, exponent);
   };
   const auto E = [&](const double exponent) {
-    return ProfileError(x, points_cam, model, tz_of_exponent(exponent));
+    return ProfileError(x, points_cam, known_focal, model,
+                        tz_of_exponent(exponent));
   };
   std::vector<double> exponents(kNumGridPoints);
   std::vector<double> errors(kNumGridPoints);
@@ -124,8 +126,9 @@ std::vector<RadialIntrinsics> SolveRadialIntrinsicsLeastSquares(
     RadialIntrinsics candidate = model;
     candidate.tz = tz_of_exponent(exponent);
     double squared_error = 0;
-    if (RefineRadialProfileAndTz(x, points_cam, kMaxNumPolishIterations,
-                                 &candidate, &squared_error) &&
+    if (RefineRadialProfileAndTz(x, points_cam, known_focal,
+                                 kMaxNumPolishIterations, &candidate,
+                                 &squared_error) &&
         RadiusGrowsOverPoints(x, points_cam, candidate)) {
       candidates.emplace_back(squared_error, candidate);
     }

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <iostream>
 #include <vector>
 
 #include "tests/src/solvers/radial_intrinsics_scene.h"
@@ -38,7 +40,7 @@ TEST(SolveRadialIntrinsicsLeastSquares, ExactData) {
           MakeRadialIntrinsicsScene(truth, 200, MaxAngleDeg(profile), 20);
       const std::vector<RadialIntrinsics> models =
           SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile,
-                                            num_terms);
+                                            num_terms, std::nullopt);
       ASSERT_FALSE(models.empty());
       EXPECT_LE(models.size(), 3);
       EXPECT_LT(RelativeError(models[0], truth, 1), 1e-8);
@@ -59,13 +61,62 @@ TEST(SolveRadialIntrinsicsLeastSquares, NoisyData) {
         MakeRadialIntrinsicsScene(truth, 500, MaxAngleDeg(profile), 7);
     testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
     const std::vector<RadialIntrinsics> models =
-        SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile,
-                                          2);
+        SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile, 2,
+                                          std::nullopt);
     ASSERT_FALSE(models.empty());
     EXPECT_NEAR(models[0].focal, truth.focal, 0.001 * truth.focal);
     EXPECT_NEAR(models[0].tz, truth.tz, 0.002);
     EXPECT_NEAR(models[0].k[0], truth.k[0], 0.005);
     EXPECT_NEAR(models[0].k[1], truth.k[1], 0.005);
+  }
+}
+
+// With the true f given, exact data of each profile and number of terms: the
+// first solution is the truth to 1e-8 with f the given value bit for bit.
+TEST(SolveRadialIntrinsicsLeastSquares, KnownFocalExactData) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    for (int num_terms = 0; num_terms <= 2; ++num_terms) {
+      SCOPED_TRACE(10 * static_cast<int>(profile) + num_terms);
+      const RadialIntrinsics truth = Truth(profile, num_terms);
+      const RadialIntrinsicsScene scene =
+          MakeRadialIntrinsicsScene(truth, 200, MaxAngleDeg(profile), 20);
+      const std::vector<RadialIntrinsics> models =
+          SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile,
+                                            num_terms, truth.focal);
+      ASSERT_FALSE(models.empty());
+      EXPECT_LT(RelativeError(models[0], truth, 1), 1e-8);
+      for (const RadialIntrinsics& model : models) {
+        EXPECT_EQ(model.focal, truth.focal);
+      }
+    }
+  }
+}
+
+// With the true f given, 0.5 px noise on 500 points: tz and k at least as
+// close as with f estimated (NoisyData's bounds), f exact.
+TEST(SolveRadialIntrinsicsLeastSquares, KnownFocalNoisyData) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    SCOPED_TRACE(static_cast<int>(profile));
+    const RadialIntrinsics truth = Truth(profile, 2);
+    RadialIntrinsicsScene scene =
+        MakeRadialIntrinsicsScene(truth, 500, MaxAngleDeg(profile), 7);
+    testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
+    const std::vector<RadialIntrinsics> models =
+        SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam, profile, 2,
+                                          truth.focal);
+    ASSERT_FALSE(models.empty());
+    EXPECT_EQ(models[0].focal, truth.focal);
+    EXPECT_NEAR(models[0].tz, truth.tz, 0.002);
+    EXPECT_NEAR(models[0].k[0], truth.k[0], 0.005);
+    EXPECT_NEAR(models[0].k[1], truth.k[1], 0.005);
+    std::cout << (profile == RadialProfile::kPolynomial ? "polynomial"
+                                                        : "equidistant")
+              << " f known: |tz error| " << std::abs(models[0].tz - truth.tz)
+              << " m, |k1 error| " << std::abs(models[0].k[0] - truth.k[0])
+              << ", |k2 error| " << std::abs(models[0].k[1] - truth.k[1])
+              << "\n";
   }
 }
 
@@ -77,11 +128,12 @@ TEST(SolveRadialIntrinsicsLeastSquares, RejectsMirroringProfiles) {
     point.head<2>() *= -1;
   }
   EXPECT_TRUE(SolveRadialIntrinsicsLeastSquares(scene.x, scene.points_cam,
-                                                RadialProfile::kPolynomial, 2)
+                                                RadialProfile::kPolynomial, 2,
+                                                std::nullopt)
                   .empty());
-  EXPECT_TRUE(
-      SolveRadialIntrinsicsLeastSquares({}, {}, RadialProfile::kPolynomial, 2)
-          .empty());
+  EXPECT_TRUE(SolveRadialIntrinsicsLeastSquares(
+                  {}, {}, RadialProfile::kPolynomial, 2, std::nullopt)
+                  .empty());
 }
 
 }  // namespace

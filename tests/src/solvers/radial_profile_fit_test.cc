@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tests/src/solvers/radial_intrinsics_scene.h"
@@ -31,19 +32,19 @@ TEST(FitRadialProfile, ExactAtTheTrueTz) {
     model.focal = 1;
     model.k[0] = model.k[1] = 0;
     double squared_error = -1;
-    ASSERT_TRUE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &model, &squared_error));
     EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
     EXPECT_LT(squared_error, 1e-16);
     // Any other tz fits worse.
     model.tz = truth.tz + 0.1;
-    ASSERT_TRUE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &model, &squared_error));
     EXPECT_GT(squared_error, 1);
     // Points behind the camera.
     model.tz = -100;
-    EXPECT_FALSE(
-        FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+    EXPECT_FALSE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                  &model, &squared_error));
   }
 }
 
@@ -56,13 +57,13 @@ TEST(FitRadialProfile, OnlyTheRequestedTerms) {
   RadialIntrinsics model = truth;
   model.num_radial_terms = 1;
   double squared_error = 0;
-  ASSERT_TRUE(
-      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt, &model,
+                               &squared_error));
   EXPECT_EQ(model.k[1], 0);
   EXPECT_GT(squared_error, 1);
   model.num_radial_terms = 3;
-  EXPECT_FALSE(
-      FitRadialProfile(scene.x, scene.points_cam, &model, &squared_error));
+  EXPECT_FALSE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt, &model,
+                                &squared_error));
 }
 
 // From tz 0.3 m off the truth, Gauss-Newton reaches the truth on exact data
@@ -76,23 +77,100 @@ TEST(RefineRadialProfileAndTz, ConvergesFromAWrongTz) {
     RadialIntrinsics model = truth;
     model.tz += 0.3;
     double squared_error = -1;
-    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
-                                         &squared_error));
+    ASSERT_TRUE(RefineRadialProfileAndTz(
+        scene.x, scene.points_cam, std::nullopt, 10, &model, &squared_error));
     EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
     EXPECT_LT(squared_error, 1e-16);
 
     testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
     RadialIntrinsics at_truth = truth;
     double error_at_truth = 0;
-    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, &at_truth,
-                                 &error_at_truth));
+    ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, std::nullopt,
+                                 &at_truth, &error_at_truth));
     model = truth;
     model.tz += 0.3;
-    ASSERT_TRUE(RefineRadialProfileAndTz(scene.x, scene.points_cam, 10, &model,
-                                         &squared_error));
+    ASSERT_TRUE(RefineRadialProfileAndTz(
+        scene.x, scene.points_cam, std::nullopt, 10, &model, &squared_error));
     EXPECT_LT(squared_error, error_at_truth);
     EXPECT_NEAR(model.tz, truth.tz, 0.05);
     EXPECT_NEAR(model.focal, truth.focal, 0.01 * truth.focal);
+  }
+}
+
+// With the true f given: at the true tz the distortion terms are exact for
+// 0, 1 and 2 terms (no unknown at all for 0 terms, only the error), and f is
+// the given value bit for bit; a known f that is not finite and positive is
+// refused.
+TEST(FitRadialProfile, KnownFocalExactAtTheTrueTz) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    for (int num_terms = 0; num_terms <= 2; ++num_terms) {
+      SCOPED_TRACE(10 * static_cast<int>(profile) + num_terms);
+      RadialIntrinsics truth = Truth(profile);
+      truth.num_radial_terms = num_terms;
+      if (num_terms < 2) truth.k[1] = 0;
+      if (num_terms < 1) truth.k[0] = 0;
+      const RadialIntrinsicsScene scene =
+          MakeRadialIntrinsicsScene(truth, 100, 45, 5);
+      RadialIntrinsics model = truth;
+      model.focal = 1;
+      model.k[0] = model.k[1] = 0.5;
+      double squared_error = -1;
+      ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, truth.focal,
+                                   &model, &squared_error));
+      EXPECT_EQ(model.focal, truth.focal);
+      EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
+      EXPECT_LT(squared_error, 1e-16);
+      // A 2 % wrong f does not fit.
+      ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam,
+                                   1.02 * truth.focal, &model, &squared_error));
+      EXPECT_EQ(model.focal, 1.02 * truth.focal);
+      EXPECT_GT(squared_error, 1);
+      for (const double bad_focal :
+           {0.0, -truth.focal, std::numeric_limits<double>::quiet_NaN()}) {
+        EXPECT_FALSE(FitRadialProfile(scene.x, scene.points_cam, bad_focal,
+                                      &model, &squared_error));
+      }
+    }
+  }
+}
+
+// With the true f given, from tz 0.3 m off the truth Gauss-Newton over tz
+// and k reaches the truth on exact data with f unchanged bit for bit; on
+// noisy data it reaches the optimum (a lower error than at the true tz).
+TEST(RefineRadialProfileAndTz, KnownFocalConvergesFromAWrongTz) {
+  for (const RadialProfile profile :
+       {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
+    for (int num_terms = 0; num_terms <= 2; ++num_terms) {
+      SCOPED_TRACE(10 * static_cast<int>(profile) + num_terms);
+      RadialIntrinsics truth = Truth(profile);
+      truth.num_radial_terms = num_terms;
+      if (num_terms < 2) truth.k[1] = 0;
+      if (num_terms < 1) truth.k[0] = 0;
+      RadialIntrinsicsScene scene =
+          MakeRadialIntrinsicsScene(truth, 200, 45, 7);
+      RadialIntrinsics model = truth;
+      model.tz += 0.3;
+      double squared_error = -1;
+      ASSERT_TRUE(RefineRadialProfileAndTz(
+          scene.x, scene.points_cam, truth.focal, 10, &model, &squared_error));
+      EXPECT_EQ(model.focal, truth.focal);
+      EXPECT_LT(RelativeError(model, truth, 1), 1e-10);
+      EXPECT_LT(squared_error, 1e-16);
+
+      testing::AddNoiseAndOutliers(0.5, 0, 8, &scene);
+      RadialIntrinsics at_truth = truth;
+      double error_at_truth = 0;
+      ASSERT_TRUE(FitRadialProfile(scene.x, scene.points_cam, truth.focal,
+                                   &at_truth, &error_at_truth));
+      model = truth;
+      model.tz += 0.3;
+      ASSERT_TRUE(RefineRadialProfileAndTz(
+          scene.x, scene.points_cam, truth.focal, 10, &model, &squared_error));
+      EXPECT_EQ(model.focal, truth.focal);
+      EXPECT_LT(squared_error, error_at_truth);
+      EXPECT_NEAR(model.tz, truth.tz, 0.02);
+    }
   }
 }
 
