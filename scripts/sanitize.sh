@@ -30,6 +30,8 @@ export CCACHE_BASEDIR="$repo"
 # before the build.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-halt_on_error=1:abort_on_error=0:detect_leaks=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+# Leaks of other people's code that we cannot fix (each explained there).
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$repo/scripts/lsan_suppressions.txt:print_suppressions=0}"
 # Eigen assumes glibc's malloc is 16-byte aligned except under ASan
 # (__SANITIZE_ADDRESS__, Eigen/src/Core/util/Memory.h), where it switches to
 # its own offset allocation. COLMAP's uninstrumented code allocates Eigen

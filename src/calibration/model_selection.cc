@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <numeric>
 #include <random>
+#include <set>
 #include <sstream>
 
 namespace rig_calibrator {
@@ -342,6 +343,88 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
   return true;
 }
 
+// The residual profile of a fit over its inliers (radial_residual_profile.h),
+// the points projected with the fit's tz as in the upgrade.
+RadialResidualProfile FitResidualProfile(
+    const ModelSelectionOptions& options, const CandidateFit& fit,
+    const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam) {
+  std::vector<Eigen::Vector2d> observed, projected;
+  for (size_t row = 0; row < points2D.size(); ++row) {
+    if (row >= fit.result.inlier_mask.size() || !fit.result.inlier_mask[row]) {
+      continue;
+    }
+    const double depth = points_cam[row].z() + fit.result.tz;
+    if (!(depth > 0)) continue;
+    observed.push_back(points2D[row]);
+    projected.push_back(fit.camera.WorldToImage(Eigen::Vector2d(
+        points_cam[row].x() / depth, points_cam[row].y() / depth)));
+  }
+  return ComputeRadialResidualProfile(
+      Eigen::Vector2d(fit.camera.PrincipalPointX(),
+                      fit.camera.PrincipalPointY()),
+      observed, projected, options.validity.residual_profile);
+}
+
+// Too few framesets for the held-out comparison: kFewFramesetsModels in
+// order, the first that is valid over the image and follows the lens where
+// there are data (model_validity.h, checks 1-3) wins.
+bool SelectCameraModelFromFewFramesets(
+    const ModelSelectionOptions& options,
+    const CameraUpgradeOptions& upgrade_options,
+    const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam, int num_framesets,
+    colmap::Camera* camera, CameraUpgradeResult* result, ModelChoice* choice) {
+  const std::string why = std::to_string(num_framesets) +
+                          " framesets see this camera, too few to compare "
+                          "models by held-out error (at least " +
+                          std::to_string(options.min_num_framesets) + ")";
+  for (const char* model : kFewFramesetsModels) {
+    ModelCandidate candidate;
+    candidate.model = model;
+    CandidateFit fit;
+    fit.camera.InitializeWithName(model, camera->MeanFocalLength(),
+                                  camera->Width(), camera->Height());
+    fit.camera.SetPrincipalPointX(camera->PrincipalPointX());
+    fit.camera.SetPrincipalPointY(camera->PrincipalPointY());
+    candidate.num_params = static_cast<int>(fit.camera.NumParams());
+    candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
+                                     &fit.camera, &fit.result);
+    if (!candidate.fitted) {
+      candidate.note = "no fit: " + fit.result.error_message;
+      choice->candidates.push_back(candidate);
+      continue;
+    }
+    candidate.num_inliers = fit.result.num_inliers;
+    candidate.train_rms_px = fit.result.rms_px;
+    fit.validity = CheckModelValidity(fit.camera, options.validity);
+    AddResidualProfileCheck(
+        fit.camera, FitResidualProfile(options, fit, points2D, points_cam),
+        /*parameters_held=*/false, &fit.validity);
+    candidate.valid = fit.validity.valid;
+    if (!candidate.valid) {
+      candidate.note = "invalid: " + fit.validity.message;
+      choice->candidates.push_back(candidate);
+      continue;
+    }
+    candidate.chosen = true;
+    candidate.note = "the first valid one";
+    choice->candidates.push_back(candidate);
+    choice->chosen = model;
+    choice->reason = why + ": " + model +
+                     ", the first of OPENCV, OPENCV_FISHEYE that is valid "
+                     "over the image and follows the lens where there are "
+                     "data";
+    *camera = fit.camera;
+    *result = fit.result;
+    return true;
+  }
+  result->error_message = why + ", and neither OPENCV nor OPENCV_FISHEYE " +
+                          "could be fitted and is valid over the whole image";
+  choice->reason = result->error_message;
+  return false;
+}
+
 }  // namespace
 
 bool SelectCameraModel(const ModelSelectionOptions& options,
@@ -357,6 +440,13 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
     result->error_message = "one frameset per correspondence needed";
     choice->reason = result->error_message;
     return false;
+  }
+  const int num_framesets =
+      static_cast<int>(std::set<int>(groups.begin(), groups.end()).size());
+  if (num_framesets < options.min_num_framesets) {
+    return SelectCameraModelFromFewFramesets(options, upgrade_options, points2D,
+                                             points_cam, num_framesets, camera,
+                                             result, choice);
   }
   if (points2D.size() <= static_cast<size_t>(options.max_num_fit_rows)) {
     return SelectCameraModelOnRows(options, upgrade_options, points2D,

@@ -47,6 +47,14 @@ namespace rig_calibrator {
 // The --RigCalibrator.camera_model value that asks for the choice.
 inline constexpr char kAutoCameraModel[] = "auto";
 
+// With fewer framesets than ModelSelectionOptions::min_num_framesets the
+// held-out error of 5 folds is mostly noise (a fold holds one frameset or
+// none): these are tried in order and the first valid over the image that
+// follows the lens where there are data (model_validity.h, all three
+// checks) wins.
+inline constexpr const char* kFewFramesetsModels[] = {"OPENCV",
+                                                      "OPENCV_FISHEYE"};
+
 // Differences of mean squared held-out error below this (px^2, i.e. 0.01 px
 // of RMS on exact data) carry no information.
 constexpr double kMinMseDifference = 1e-4;
@@ -56,6 +64,9 @@ struct ModelSelectionOptions {
       "SIMPLE_RADIAL",         "RADIAL",         "OPENCV",
       "SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE", "OPENCV_FISHEYE"};
   int num_folds = 5;
+  // Framesets (distinct groups) needed for the held-out comparison; fewer:
+  // kFewFramesetsModels.
+  int min_num_framesets = 10;
   double significance = 2.0;  // z of the choice rule
   // The held-out evaluation uses at most this many rows (a fixed random
   // subset): its statistics need a few thousand, not 1e5.

@@ -1,6 +1,9 @@
 // SelectCameraModel on exact and noisy correspondences of known cameras: a
 // fisheye model for a 150-degree lens, the pinhole-type model of the data
-// for narrow lenses, and no more parameters than the data need.
+// for narrow lenses, and no more parameters than the data need; with too few
+// framesets OPENCV unless it cannot represent the lens, then OPENCV_FISHEYE;
+// with many rows the candidates compared on a subset, the winner fitted to
+// all.
 #include "src/calibration/model_selection.h"
 
 #include <gtest/gtest.h>
@@ -29,7 +32,8 @@ struct Data {
 // points moved by -tz (the upgrade adds tz back); `noise_px` Gaussian pixel
 // noise and `outlier_fraction` of rows with a random pixel.
 Data MakeData(const colmap::Camera& truth, double tz, int num_points,
-              double noise_px, double outlier_fraction, unsigned seed) {
+              double noise_px, double outlier_fraction, unsigned seed,
+              int num_groups = 20) {
   std::mt19937 generator(seed);
   std::uniform_real_distribution<double> x(0, truth.Width());
   std::uniform_real_distribution<double> y(0, truth.Height());
@@ -49,7 +53,7 @@ Data MakeData(const colmap::Camera& truth, double tz, int num_points,
     }
     data.points2D.push_back(observed);
     data.points_cam.push_back(point - Eigen::Vector3d(0, 0, tz));
-    data.groups.push_back(i % 20);
+    data.groups.push_back(i % num_groups);
   }
   return data;
 }
@@ -82,16 +86,17 @@ struct Selected {
   ModelChoice choice;
 };
 
-Selected Select(const colmap::Camera& truth, const Data& data) {
+Selected Select(
+    const colmap::Camera& truth, const Data& data,
+    const ModelSelectionOptions& options = ModelSelectionOptions()) {
   Selected selected;
   selected.camera = MakeCamera(
       "OPENCV", truth.Width(), truth.Height(),
       {1.2 * truth.Width(), 1.2 * truth.Width(), truth.PrincipalPointX() + 3,
        truth.PrincipalPointY() - 2, 0, 0, 0, 0});
-  selected.success =
-      SelectCameraModel(ModelSelectionOptions(), CameraUpgradeOptions(),
-                        data.points2D, data.points_cam, data.groups,
-                        &selected.camera, &selected.result, &selected.choice);
+  selected.success = SelectCameraModel(
+      options, CameraUpgradeOptions(), data.points2D, data.points_cam,
+      data.groups, &selected.camera, &selected.result, &selected.choice);
   std::cout << FormatModelChoice(selected.choice, "  ");
   return selected;
 }
@@ -200,6 +205,63 @@ TEST(ModelSelection, NoisyNarrowLensGetsAPinholeTypeModel) {
             << " mean/max projection error " << mean_px << "/" << max_px
             << " px" << std::endl;
   EXPECT_LT(mean_px, 0.1);
+}
+
+TEST(ModelSelection, FewFramesetsNarrowLensGetsOpenCV) {
+  // 4 framesets: no held-out comparison; OPENCV fits and follows the lens.
+  const colmap::Camera truth =
+      MakeCamera("OPENCV", 752, 480,
+                 {458.654, 457.296, 367.215, 248.375, -0.28340811, 0.07395907,
+                  0.00019359, 1.76187114e-05});
+  const Selected selected =
+      Select(truth, MakeData(truth, 0.0, 2000, 0.5, 0.2, 7, /*num_groups=*/4));
+  ASSERT_TRUE(selected.success);
+  EXPECT_EQ(selected.choice.chosen, "OPENCV");
+  EXPECT_EQ(selected.choice.candidates.size(), 1u);
+  EXPECT_NE(selected.choice.reason.find("4 framesets"), std::string::npos);
+  double mean_px, max_px;
+  ProjectionDifference(truth, selected.camera, &mean_px, &max_px);
+  EXPECT_LT(mean_px, 0.1);
+}
+
+TEST(ModelSelection, FewFramesetsWideFisheyeGetsOpenCVFisheye) {
+  // 4 framesets of a 155-degree lens: OPENCV folds or cannot follow it
+  // (checks 1-3 of model_validity.h), OPENCV_FISHEYE is taken, as accurate
+  // as the true model by hand.
+  const colmap::Camera truth = WideFisheye();
+  const Data data = MakeData(truth, 0.1, 3000, 0.5, 0.2, 8, /*num_groups=*/4);
+  const Selected selected = Select(truth, data);
+  ASSERT_TRUE(selected.success);
+  EXPECT_EQ(selected.choice.chosen, "OPENCV_FISHEYE");
+  ASSERT_EQ(selected.choice.candidates.size(), 2u);
+  EXPECT_FALSE(Candidate(selected.choice, "OPENCV").valid);
+  double mean_px, max_px;
+  ProjectionDifference(truth, selected.camera, &mean_px, &max_px);
+  std::cout << "few framesets, fisheye: mean/max projection error " << mean_px
+            << "/" << max_px << " px" << std::endl;
+  EXPECT_LT(mean_px, 0.2);
+}
+
+TEST(ModelSelection, CandidatesOnASubsetWinnerOnAllRows) {
+  // 1500 of 4000 rows compare the candidates; the winner is fitted to all
+  // 4000 (its inlier mask covers them) and is exact.
+  const colmap::Camera truth = WideFisheye();
+  const Data data = MakeData(truth, 0.1, 4000, 0, 0, 9);
+  ModelSelectionOptions options;
+  options.max_num_fit_rows = 1500;
+  const Selected selected = Select(truth, data, options);
+  ASSERT_TRUE(selected.success);
+  EXPECT_EQ(selected.choice.chosen, "OPENCV_FISHEYE");
+  EXPECT_EQ(Candidate(selected.choice, "OPENCV_FISHEYE").num_inliers, 1500);
+  ASSERT_EQ(selected.result.inlier_mask.size(), 4000u);
+  EXPECT_EQ(selected.result.num_inliers, 4000);
+  EXPECT_NE(selected.choice.reason.find("compared on 1500 of 4000"),
+            std::string::npos);
+  for (size_t i = 0; i < truth.NumParams(); ++i) {
+    EXPECT_NEAR(selected.camera.Params()[i], truth.Params()[i],
+                1e-6 * std::max(1.0, std::abs(truth.Params()[i])))
+        << i;
+  }
 }
 
 TEST(ModelSelection, MismatchedGroupsFail) {
