@@ -123,6 +123,18 @@ bool RefineOnRowsForModel(int model_id,
   }
 }
 
+// The start of a candidate's upgrade: `model` with the camera's size, mean
+// focal length and principal point (the upgrade estimates the rest).
+colmap::Camera CandidateStart(const std::string& model,
+                              const colmap::Camera& camera) {
+  colmap::Camera start;
+  start.InitializeWithName(model, camera.MeanFocalLength(), camera.Width(),
+                           camera.Height());
+  start.SetPrincipalPointX(camera.PrincipalPointX());
+  start.SetPrincipalPointY(camera.PrincipalPointY());
+  return start;
+}
+
 // A candidate's full fit.
 struct CandidateFit {
   colmap::Camera camera;
@@ -218,10 +230,7 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
       fits.push_back(fit);
       continue;
     }
-    fit.camera.InitializeWithName(model, camera->MeanFocalLength(),
-                                  camera->Width(), camera->Height());
-    fit.camera.SetPrincipalPointX(camera->PrincipalPointX());
-    fit.camera.SetPrincipalPointY(camera->PrincipalPointY());
+    fit.camera = CandidateStart(model, *camera);
     candidate.num_params = static_cast<int>(fit.camera.NumParams());
     candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
                                      &fit.camera, &fit.result);
@@ -383,10 +392,7 @@ bool SelectCameraModelFromFewFramesets(
     ModelCandidate candidate;
     candidate.model = model;
     CandidateFit fit;
-    fit.camera.InitializeWithName(model, camera->MeanFocalLength(),
-                                  camera->Width(), camera->Height());
-    fit.camera.SetPrincipalPointX(camera->PrincipalPointX());
-    fit.camera.SetPrincipalPointY(camera->PrincipalPointY());
+    fit.camera = CandidateStart(model, *camera);
     candidate.num_params = static_cast<int>(fit.camera.NumParams());
     candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
                                      &fit.camera, &fit.result);
@@ -472,10 +478,7 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
     *result = subset_result;
     return false;
   }
-  chosen_camera.InitializeWithName(choice->chosen, camera->MeanFocalLength(),
-                                   camera->Width(), camera->Height());
-  chosen_camera.SetPrincipalPointX(camera->PrincipalPointX());
-  chosen_camera.SetPrincipalPointY(camera->PrincipalPointY());
+  chosen_camera = CandidateStart(choice->chosen, *camera);
   if (!UpgradeCamera(upgrade_options, points2D, points_cam, &chosen_camera,
                      result)) {
     choice->reason += "; fitting it to all " + std::to_string(points2D.size()) +
