@@ -211,6 +211,62 @@ std::string Fixed(double value, int precision) {
   return stream.str();
 }
 
+// The residual profile of a fit over its inliers (radial_residual_profile.h),
+// the points projected with the fit's tz as in the upgrade.
+RadialResidualProfile FitResidualProfile(
+    const ModelSelectionOptions& options, const CandidateFit& fit,
+    const std::vector<Eigen::Vector2d>& points2D,
+    const std::vector<Eigen::Vector3d>& points_cam) {
+  std::vector<Eigen::Vector2d> observed, projected;
+  for (size_t row = 0; row < points2D.size(); ++row) {
+    if (row >= fit.result.inlier_mask.size() || !fit.result.inlier_mask[row]) {
+      continue;
+    }
+    const double depth = points_cam[row].z() + fit.result.tz;
+    if (!(depth > 0)) continue;
+    observed.push_back(points2D[row]);
+    projected.push_back(fit.camera.WorldToImage(Eigen::Vector2d(
+        points_cam[row].x() / depth, points_cam[row].y() / depth)));
+  }
+  return ComputeRadialResidualProfile(
+      Eigen::Vector2d(fit.camera.PrincipalPointX(),
+                      fit.camera.PrincipalPointY()),
+      observed, projected, options.validity.residual_profile);
+}
+
+// Fits `model` by the upgrade from `camera`'s size and principal point and
+// fills its row of the table: parameters, inliers and training RMS, or why
+// it could not be fitted or is not valid (checks 1 and 2 of
+// model_validity.h, and with `check_data` check 3 on its inliers).
+CandidateFit FitCandidate(const std::string& model,
+                          const ModelSelectionOptions& options,
+                          const CameraUpgradeOptions& upgrade_options,
+                          const std::vector<Eigen::Vector2d>& points2D,
+                          const std::vector<Eigen::Vector3d>& points_cam,
+                          const colmap::Camera& camera, bool check_data,
+                          ModelCandidate* candidate) {
+  CandidateFit fit;
+  fit.camera = CandidateStart(model, camera);
+  candidate->num_params = static_cast<int>(fit.camera.NumParams());
+  candidate->fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
+                                    &fit.camera, &fit.result);
+  if (!candidate->fitted) {
+    candidate->note = "no fit: " + fit.result.error_message;
+    return fit;
+  }
+  candidate->num_inliers = fit.result.num_inliers;
+  candidate->train_rms_px = fit.result.rms_px;
+  fit.validity = CheckModelValidity(fit.camera, options.validity);
+  if (check_data) {
+    AddResidualProfileCheck(
+        fit.camera, FitResidualProfile(options, fit, points2D, points_cam),
+        /*parameters_held=*/false, &fit.validity);
+  }
+  candidate->valid = fit.validity.valid;
+  if (!candidate->valid) candidate->note = "invalid: " + fit.validity.message;
+  return fit;
+}
+
 // SelectCameraModel on all the given rows.
 bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
                              const CameraUpgradeOptions& upgrade_options,
@@ -230,19 +286,8 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
       fits.push_back(fit);
       continue;
     }
-    fit.camera = CandidateStart(model, *camera);
-    candidate.num_params = static_cast<int>(fit.camera.NumParams());
-    candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
-                                     &fit.camera, &fit.result);
-    if (!candidate.fitted) {
-      candidate.note = "no fit: " + fit.result.error_message;
-    } else {
-      candidate.num_inliers = fit.result.num_inliers;
-      candidate.train_rms_px = fit.result.rms_px;
-      fit.validity = CheckModelValidity(fit.camera, options.validity);
-      candidate.valid = fit.validity.valid;
-      if (!candidate.valid) candidate.note = "invalid: " + fit.validity.message;
-    }
+    fit = FitCandidate(model, options, upgrade_options, points2D, points_cam,
+                       *camera, /*check_data=*/false, &candidate);
     choice->candidates.push_back(candidate);
     fits.push_back(fit);
   }
@@ -352,29 +397,6 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
   return true;
 }
 
-// The residual profile of a fit over its inliers (radial_residual_profile.h),
-// the points projected with the fit's tz as in the upgrade.
-RadialResidualProfile FitResidualProfile(
-    const ModelSelectionOptions& options, const CandidateFit& fit,
-    const std::vector<Eigen::Vector2d>& points2D,
-    const std::vector<Eigen::Vector3d>& points_cam) {
-  std::vector<Eigen::Vector2d> observed, projected;
-  for (size_t row = 0; row < points2D.size(); ++row) {
-    if (row >= fit.result.inlier_mask.size() || !fit.result.inlier_mask[row]) {
-      continue;
-    }
-    const double depth = points_cam[row].z() + fit.result.tz;
-    if (!(depth > 0)) continue;
-    observed.push_back(points2D[row]);
-    projected.push_back(fit.camera.WorldToImage(Eigen::Vector2d(
-        points_cam[row].x() / depth, points_cam[row].y() / depth)));
-  }
-  return ComputeRadialResidualProfile(
-      Eigen::Vector2d(fit.camera.PrincipalPointX(),
-                      fit.camera.PrincipalPointY()),
-      observed, projected, options.validity.residual_profile);
-}
-
 // Too few framesets for the held-out comparison: kFewFramesetsModels in
 // order, the first that is valid over the image and follows the lens where
 // there are data (model_validity.h, checks 1-3) wins.
@@ -391,25 +413,10 @@ bool SelectCameraModelFromFewFramesets(
   for (const char* model : kFewFramesetsModels) {
     ModelCandidate candidate;
     candidate.model = model;
-    CandidateFit fit;
-    fit.camera = CandidateStart(model, *camera);
-    candidate.num_params = static_cast<int>(fit.camera.NumParams());
-    candidate.fitted = UpgradeCamera(upgrade_options, points2D, points_cam,
-                                     &fit.camera, &fit.result);
-    if (!candidate.fitted) {
-      candidate.note = "no fit: " + fit.result.error_message;
-      choice->candidates.push_back(candidate);
-      continue;
-    }
-    candidate.num_inliers = fit.result.num_inliers;
-    candidate.train_rms_px = fit.result.rms_px;
-    fit.validity = CheckModelValidity(fit.camera, options.validity);
-    AddResidualProfileCheck(
-        fit.camera, FitResidualProfile(options, fit, points2D, points_cam),
-        /*parameters_held=*/false, &fit.validity);
-    candidate.valid = fit.validity.valid;
+    const CandidateFit fit =
+        FitCandidate(model, options, upgrade_options, points2D, points_cam,
+                     *camera, /*check_data=*/true, &candidate);
     if (!candidate.valid) {
-      candidate.note = "invalid: " + fit.validity.message;
       choice->candidates.push_back(candidate);
       continue;
     }
