@@ -152,8 +152,11 @@ TEST_F(CameraModelCommandTest, AutoChoosesFisheyeAsAccurateAsByHand) {
   const std::string by_hand = temp_->File("opencv_fisheye");
   const std::string automatic = temp_->File("auto");
   ASSERT_EQ(Calibrate("OPENCV_FISHEYE", by_hand), EXIT_SUCCESS);
-  for (const nlohmann::json& camera :
-       ReadJson(by_hand + "/calibration_summary.json")["cameras"]) {
+  // A named summary: a range-for over a member of the temporary would read
+  // it after its end (ASan's heap-use-after-free).
+  const nlohmann::json hand_summary =
+      ReadJson(by_hand + "/calibration_summary.json");
+  for (const nlohmann::json& camera : hand_summary["cameras"]) {
     EXPECT_TRUE(camera["validity"]["fits_data"].get<bool>()) << camera["name"];
   }
   ASSERT_EQ(Calibrate("auto", automatic), EXIT_SUCCESS);
