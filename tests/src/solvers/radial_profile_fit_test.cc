@@ -97,6 +97,15 @@ TEST(RefineRadialProfileAndTz, ConvergesFromAWrongTz) {
   }
 }
 
+// Truth(profile) with only its first num_terms distortion terms.
+RadialIntrinsics TruthWithTerms(const RadialProfile profile,
+                                const int num_terms) {
+  RadialIntrinsics truth = Truth(profile);
+  truth.num_radial_terms = num_terms;
+  for (int j = num_terms; j < 2; ++j) truth.k[j] = 0;
+  return truth;
+}
+
 // With the true f given: at the true tz the distortion terms are exact for
 // 0, 1 and 2 terms (no unknown at all for 0 terms, only the error), and f is
 // the given value bit for bit; a known f that is not finite and positive is
@@ -106,10 +115,7 @@ TEST(FitRadialProfile, KnownFocalExactAtTheTrueTz) {
        {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
     for (int num_terms = 0; num_terms <= 2; ++num_terms) {
       SCOPED_TRACE(10 * static_cast<int>(profile) + num_terms);
-      RadialIntrinsics truth = Truth(profile);
-      truth.num_radial_terms = num_terms;
-      if (num_terms < 2) truth.k[1] = 0;
-      if (num_terms < 1) truth.k[0] = 0;
+      const RadialIntrinsics truth = TruthWithTerms(profile, num_terms);
       const RadialIntrinsicsScene scene =
           MakeRadialIntrinsicsScene(truth, 100, 45, 5);
       RadialIntrinsics model = truth;
@@ -143,10 +149,7 @@ TEST(RefineRadialProfileAndTz, KnownFocalConvergesFromAWrongTz) {
        {RadialProfile::kPolynomial, RadialProfile::kEquidistant}) {
     for (int num_terms = 0; num_terms <= 2; ++num_terms) {
       SCOPED_TRACE(10 * static_cast<int>(profile) + num_terms);
-      RadialIntrinsics truth = Truth(profile);
-      truth.num_radial_terms = num_terms;
-      if (num_terms < 2) truth.k[1] = 0;
-      if (num_terms < 1) truth.k[0] = 0;
+      const RadialIntrinsics truth = TruthWithTerms(profile, num_terms);
       RadialIntrinsicsScene scene =
           MakeRadialIntrinsicsScene(truth, 200, 45, 7);
       RadialIntrinsics model = truth;
