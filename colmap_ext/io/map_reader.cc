@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <unordered_map>
+#include <vector>
 
 #include "colmap_ext/io/colmap_camera_models.h"
 #include "colmap_ext/io/model_unique_ids.h"
@@ -105,20 +106,64 @@ bool CheckBinaryRecords(const fs::path& file, const char* count_what,
   return walker.CheckEnd();
 }
 
+// COLMAP 3.8 aborts (CHECK in Image::SetCameraId) on an image whose camera
+// id is kInvalidCameraId, 2^32 - 1 (also what "-1" becomes in images.txt).
+bool InvalidCameraIdError(const fs::path& file, std::string* error) {
+  *error = file.string() + ": an image has the camera id " +
+           std::to_string(colmap::kInvalidCameraId) +
+           ", COLMAP's invalid id: give every image the id of a camera in "
+           "cameras of the model";
+  return false;
+}
+
 // Record layouts of COLMAP's Reconstruction::Write*Binary (3.8 to 4.1).
 bool CheckImagesBinary(const fs::path& file, std::string* error) {
   return CheckBinaryRecords(
       file, "the image count",
-      [](BinaryWalker* walker) {
+      [&](BinaryWalker* walker) {
         uint64_t num_points2D = 0;
+        uint32_t camera_id = 0;
         // id, qvec, tvec, camera id, name, points2D (x, y, point3D id).
-        return walker->Skip(1, 4 + 7 * sizeof(double) + 4, "an image record") &&
+        return walker->Skip(1, 4 + 7 * sizeof(double), "an image record") &&
+               walker->Read(&camera_id, "an image's camera id") &&
+               (camera_id != colmap::kInvalidCameraId ||
+                InvalidCameraIdError(file, error)) &&
                walker->SkipString("an image name") &&
                walker->Read(&num_points2D, "a points2D count") &&
                walker->Skip(num_points2D, 2 * sizeof(double) + sizeof(uint64_t),
                             "an image's points2D");
       },
       error);
+}
+
+// images.txt read as COLMAP 3.8 does (a record line, then its points2D
+// line; fields split at single spaces by std::getline): the CAMERA_ID that
+// COLMAP parses with std::stoul and narrows to 32 bits must not be
+// kInvalidCameraId. It is the 9th field, or for a shorter line the last one
+// (std::getline on an exhausted stream leaves the previous field in place).
+// Other malformed fields make COLMAP's parser throw, which ReadWithColmap
+// reports.
+bool CheckImagesText(const fs::path& file, std::string* error) {
+  std::ifstream stream(file.string());
+  std::string line;
+  while (std::getline(stream, line)) {
+    boost::trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> fields;
+    boost::split(fields, line, boost::is_any_of(" "));
+    const std::string& camera_id =
+        fields.size() > 8 ? fields[8] : fields.back();
+    try {
+      if (static_cast<uint32_t>(std::stoul(camera_id)) ==
+          colmap::kInvalidCameraId) {
+        return InvalidCameraIdError(file, error);
+      }
+    } catch (const std::exception&) {
+      // Not a number: COLMAP's parser throws on it too.
+    }
+    std::getline(stream, line);
+  }
+  return true;
 }
 
 bool CheckPoints3DBinary(const fs::path& file, std::string* error) {
@@ -425,8 +470,9 @@ bool ReadModel(const std::string& path, colmap::Reconstruction* map,
           &cameras, error)) {
     return false;
   }
-  if (binary && (!CheckImagesBinary(folder / "images.bin", error) ||
-                 !CheckPoints3DBinary(folder / "points3D.bin", error))) {
+  if (binary ? !CheckImagesBinary(folder / "images.bin", error) ||
+                   !CheckPoints3DBinary(folder / "points3D.bin", error)
+             : !CheckImagesText(folder / "images.txt", error)) {
     return false;
   }
   if (!ReadWithColmap(folder, binary, cameras, map, info, error) ||

@@ -7,13 +7,16 @@
 #include <colmap/base/reconstruction.h>
 #include <gtest/gtest.h>
 
+#include <boost/algorithm/string.hpp>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/database_reader.h"
@@ -255,6 +258,51 @@ TEST(InputLimits, RepeatedModelIdsAreRefused) {
                 "points3D.txt has 2 point records but 1 distinct point "
                 "ids (1 appears twice): every point id must be unique "
                 "(COLMAP would keep only the first record)");
+}
+
+// Found by fuzzing the model reader (CI run of 2026-12-02): an image whose
+// camera id is 2^32 - 1, COLMAP's kInvalidCameraId (also what "-1" becomes
+// through std::stoul in images.txt), made COLMAP 3.8 abort in
+// Image::SetCameraId. Refused before COLMAP reads it, text and binary.
+TEST(InputLimits, InvalidCameraIdOfAnImageIsRefused) {
+  testing::ScopedTempDir dir;
+  const std::string folder = dir.path();
+  const std::string prefix = folder + "/";
+  const std::string expected =
+      ": an image has the camera id 4294967295, COLMAP's invalid id: give "
+      "every image the id of a camera in cameras of the model";
+  for (const std::string camera_id : {"-1", "4294967295", "8589934591"}) {
+    SCOPED_TRACE(camera_id);
+    TestModel().WriteText(folder);
+    const std::string images = testing::ReadBytes(prefix + "images.txt");
+    const size_t record = images.find("\n1 ") + 1;
+    const size_t end = images.find('\n', record);
+    std::vector<std::string> fields;
+    const std::string line = images.substr(record, end - record);
+    boost::split(fields, line, boost::is_any_of(" "));
+    ASSERT_GT(fields.size(), 9u);
+    fields[8] = camera_id;
+    WriteBytes(prefix + "images.txt", images.substr(0, record) +
+                                          boost::join(fields, " ") +
+                                          images.substr(end));
+    EXPECT_EQ(MapError(folder), prefix + "images.txt" + expected);
+  }
+  // The fuzzer's input (tests/fuzz/corpus/model/images_txt_invalid_camera_id):
+  // a record of 8 fields, whose last, TZ = -1, COLMAP reads again as the
+  // camera id.
+  TestModel().WriteText(folder);
+  WriteBytes(prefix + "images.txt", "2 0. 5.052 4 0 0 0 -1\n\n");
+  EXPECT_EQ(MapError(folder), prefix + "images.txt" + expected);
+  std::filesystem::remove(prefix + "cameras.txt");
+  std::filesystem::remove(prefix + "images.txt");
+  std::filesystem::remove(prefix + "points3D.txt");
+  WriteModel(folder);
+  std::string images = testing::ReadBytes(prefix + "images.bin");
+  // count (8), id (4), qvec and tvec (56), then the camera id.
+  const uint32_t invalid = 0xFFFFFFFFu;
+  images.replace(8 + 4 + 56, 4, Binary(invalid));
+  WriteBytes(prefix + "images.bin", images);
+  EXPECT_EQ(MapError(folder), prefix + "images.bin" + expected);
 }
 
 TEST(InputLimits, RepeatedBinaryModelIdsAreRefused) {
