@@ -10,6 +10,9 @@
 # build-fuzz/artifacts/ and makes the script fail.
 #
 # Usage: scripts/fuzz.sh [SECONDS [TARGET...]]   (default 20 s, all targets)
+#   RIG_CALIBRATOR_FUZZ_SEED=N  libFuzzer's -seed: the same mutations on every
+#                               run (scripts/run_tests.sh sets 1); unset, a new
+#                               random seed per run
 #   Reproduce a crash: build-fuzz/tests/fuzz/<target>_fuzzer <input file>
 set -euo pipefail
 
@@ -57,6 +60,7 @@ for target in "${targets[@]}"; do
   echo "[$log_tag] $target: fuzzing for $seconds s (log: $log)"
   status=0
   "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    ${RIG_CALIBRATOR_FUZZ_SEED:+-seed="$RIG_CALIBRATOR_FUZZ_SEED"} \
     -print_final_stats=1 -artifact_prefix="$fuzz_build/artifacts/$target-" \
     "$corpus" "$seeds" > "$log" 2>&1 || status=$?
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)"
