@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -40,6 +41,7 @@ ChildOutcome RunChildProcess(const std::vector<std::string>& arguments,
   }
   child_argv.push_back(nullptr);
   std::cout.flush();
+  const auto start_time = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid < 0) {
     outcome.error = "fork failed";
@@ -56,6 +58,12 @@ ChildOutcome RunChildProcess(const std::vector<std::string>& arguments,
     outcome.error = "wait4 failed";
     return outcome;
   }
+  outcome.wall_seconds = std::chrono::duration<double>(
+                             std::chrono::steady_clock::now() - start_time)
+                             .count();
+  outcome.cpu_seconds =
+      usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
+      1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   // Linux reports ru_maxrss in kilobytes.
   outcome.peak_memory_mb = usage.ru_maxrss / 1024.0;
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {

@@ -14,6 +14,9 @@ struct ChildOutcome {
   bool ok = false;          // exited with status 0
   std::string result_text;  // the contents of the result file
   double peak_memory_mb = 0;
+  // From fork to wait4's return, and the child's user + system CPU (all its
+  // threads, wait4's rusage).
+  double wall_seconds = 0, cpu_seconds = 0;
   std::string error;
 };
 

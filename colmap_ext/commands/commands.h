@@ -32,4 +32,8 @@ int RunRuntimeBenchmark(int argc, char** argv);
 // (localization_benchmark_command.cc).
 int RunLocalizationBenchmark(int argc, char** argv);
 
+// Our final bundle adjustment vs COLMAP 3.8's rig_bundle_adjuster on the same
+// problem (colmap_rig_ba_command.cc).
+int RunColmapRigBaBenchmark(int argc, char** argv);
+
 }  // namespace rig_calibrator

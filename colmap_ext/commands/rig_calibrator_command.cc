@@ -43,6 +43,9 @@ Commands() {
           {"benchmark_localization",
            {&RunLocalizationBenchmark,
             "localization throughput on a COLMAP map"}},
+          {"benchmark_colmap_rig_ba",
+           {&RunColmapRigBaBenchmark,
+            "final bundle adjustment vs COLMAP's rig_bundle_adjuster"}},
       };
   return commands;
 }
