@@ -5,14 +5,18 @@
 # 300-image map (`rig_calibrator benchmark_runtime`), optionally before and
 # after (another build's runs of the same data, in the same run), and
 # optionally the end-to-end time of the rendered demo (scripts/demo.sh)
-# split into COLMAP's steps and ours.
+# split into COLMAP's steps and ours, and optionally our final bundle
+# adjustment side by side with COLMAP 3.8's rig_bundle_adjuster on the same
+# problem (`rig_calibrator benchmark_colmap_rig_ba`).
 #
 # Usage: scripts/benchmark_runtime.sh RESULTS_DIR [benchmark_runtime options...]
 #   RESULTS_DIR  created if needed; gets runtime.md, runtime_calibration.csv,
 #                runtime_calibration.svg, runtime_localization.csv,
 #                with a baseline runtime_calibration_before.csv,
 #                runtime_log.txt and, with the demo, runtime_demo.md and
-#                runtime_demo_log.txt (other files are left alone)
+#                runtime_demo_log.txt, with the COLMAP comparison
+#                colmap_rig_ba.md, colmap_rig_ba.csv and colmap_rig_ba_log.txt
+#                (other files are left alone)
 #   options      passed to `rig_calibrator benchmark_runtime`, e.g.
 #                --framesets 10,50 --cameras 5 --localization 0
 # Environment:
@@ -23,10 +27,16 @@
 #                             previous commit): every calibration run is made
 #                             with it first, then with this build, and
 #                             runtime.md gets the before/after table
+#   RUNTIME_COLMAP_RIG_BA=1   also compare the final bundle adjustment with
+#                             COLMAP 3.8's rig_bundle_adjuster (default 100
+#                             and 500 framesets x 10 cameras, several minutes
+#                             on 2 cores; RUNTIME_COLMAP_RIG_BA_OPTIONS, e.g.
+#                             "--framesets 100", replaces the sizes)
 #   BENCHMARK_QUICK=1         without options: a smoke run (10 and 20
 #                             framesets x 5 cameras, a 30-image map, 4
 #                             localized images, this build as its own
-#                             baseline; ~20-40 s), which ctest runs
+#                             baseline, the COLMAP comparison at 10 framesets
+#                             x 5 cameras; ~20-40 s), which ctest runs
 #                             (benchmark_runtime_quick) so that it cannot rot
 set -euo pipefail
 
@@ -47,6 +57,8 @@ if [[ "${BENCHMARK_QUICK:-0}" == 1 && $# -eq 0 ]]; then
   options=(--framesets 10,20 --cameras 5 --map_images 30 --rig_features 1000
            --rig_images 4 --retrieval_images 1)
   RUNTIME_BASELINE="${RUNTIME_BASELINE:-$rig_calibrator}"
+  RUNTIME_COLMAP_RIG_BA="${RUNTIME_COLMAP_RIG_BA:-1}"
+  RUNTIME_COLMAP_RIG_BA_OPTIONS="${RUNTIME_COLMAP_RIG_BA_OPTIONS:---quick 1}"
 fi
 if [[ -n "${RUNTIME_BASELINE:-}" ]]; then
   [[ -x "$RUNTIME_BASELINE" ]] || die "RUNTIME_BASELINE=$RUNTIME_BASELINE is not an executable rig_calibrator"
@@ -58,6 +70,19 @@ status=0
 "$rig_calibrator" benchmark_runtime --output_path "$results" "${options[@]}" 2>&1 |
   tee "$results/runtime_log.txt" || status=${PIPESTATUS[0]}
 [[ "$status" -eq 0 ]] || die "rig_calibrator benchmark_runtime failed with status $status (log: $results/runtime_log.txt)"
+
+if [[ "${RUNTIME_COLMAP_RIG_BA:-0}" == 1 ]]; then
+  # Word-split on purpose: a list of options.
+  # shellcheck disable=SC2206
+  colmap_ba_options=(${RUNTIME_COLMAP_RIG_BA_OPTIONS:-})
+  echo "[benchmark_runtime] final bundle adjustment vs COLMAP's rig_bundle_adjuster ..."
+  "$rig_calibrator" benchmark_colmap_rig_ba --output_path "$results" \
+    "${colmap_ba_options[@]}" 2>&1 | tee "$results/colmap_rig_ba_log.txt" ||
+    status=${PIPESTATUS[0]}
+  [[ "$status" -eq 0 ]] || die "rig_calibrator benchmark_colmap_rig_ba failed with status $status (log: $results/colmap_rig_ba_log.txt)"
+else
+  echo "[benchmark_runtime] COLMAP rig_bundle_adjuster comparison skipped (RUNTIME_COLMAP_RIG_BA=1 runs it)"
+fi
 
 if [[ "${RUNTIME_DEMO:-0}" != 1 ]]; then
   echo "[benchmark_runtime] rendered demo skipped (RUNTIME_DEMO=1 times it)"

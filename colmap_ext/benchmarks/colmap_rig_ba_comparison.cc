@@ -69,6 +69,9 @@ struct ComparisonData {
   std::vector<int> image_ids;  // per dataset image: COLMAP image id or 0
   int num_images = 0, num_framesets = 0, num_dropped_framesets = 0;
   size_t num_points = 0;
+  // The start's inliers of posed framesets, and of them those of map points
+  // seen once (dropped before the frameset rule).
+  size_t num_start_inliers = 0, num_single_observations = 0;
 };
 
 struct SolverRun {
@@ -78,6 +81,10 @@ struct SolverRun {
   double wall_seconds = 0, cpu_seconds = 0;
   double ceres_seconds = -1;  // COLMAP's printed solver time
   double initial_rms_px = 0, final_rms_px = 0;
+  // Compared observations behind their camera in the result (not in the RMS).
+  int64_t num_behind = 0;
+  // COLMAP's own final RMS over its residuals: 2 x its printed final cost.
+  double reported_rms_px = -1;
   double max_rotation_error_deg = 0, max_center_error_m = 0;
   std::string termination;
 };
@@ -145,9 +152,10 @@ void SelectComparedObservations(ComparisonData* data) {
                    start.images[i].inlier_mask[k] &&
                    correspondence.point3D_id >= 0 &&
                    (cam_from_world * correspondence.point3D).z() > 0;
+      data->num_start_inliers += kept[i][k];
     }
   }
-  for (bool changed = true; changed;) {
+  for (bool changed = true, first = true; changed; first = false) {
     changed = false;
     std::unordered_map<int64_t, int> point_count;
     std::vector<char> frameset_has_reference(dataset.frameset_names.size(), 0);
@@ -162,9 +170,12 @@ void SelectComparedObservations(ComparisonData* data) {
     }
     for (size_t i = 0; i < dataset.images.size(); ++i) {
       for (size_t k = 0; k < kept[i].size(); ++k) {
+        const bool single =
+            point_count[dataset.images[i].correspondences[k].point3D_id] < 2;
         if (kept[i][k] &&
-            (point_count[dataset.images[i].correspondences[k].point3D_id] < 2 ||
+            (single ||
              !frameset_has_reference[dataset.images[i].frameset_index])) {
+          data->num_single_observations += first && single;
           kept[i][k] = 0;
           changed = true;
         }
@@ -442,7 +453,10 @@ bool RunColmapSide(
     view.points3D[point3D_id] = result.Point3D(colmap_id).XYZ();
     calibration.refined_points3D[point3D_id] = result.Point3D(colmap_id).XYZ();
   }
-  run.final_rms_px = RmsReprojectionError(data.observations, view);
+  const ReprojectionRms rms = RmsReprojectionError(data.observations, view);
+  run.final_rms_px = rms.rms_px;
+  run.num_behind = rms.num_unusable;
+  run.reported_rms_px = 2 * summary.final_cost_px;
   CompareWithTruth(data, calibration, /*anchor=*/true, &run);
   return true;
 }
@@ -482,9 +496,11 @@ bool RunOurSide(const ColmapRigBaComparisonOptions& options, int num_threads,
                  ? "No convergence"
                  : "Convergence")
           : summary.ceres_report;
-  run->final_rms_px = RmsReprojectionError(
+  const ReprojectionRms rms = RmsReprojectionError(
       data.observations,
       ViewOfCalibration(data, calibration, calibration.refined_points3D));
+  run->final_rms_px = rms.rms_px;
+  run->num_behind = rms.num_unusable;
   // AdjustRig anchored its free-gauge solution on the map already.
   CompareWithTruth(data, calibration, /*anchor=*/false, run);
   return true;
@@ -505,7 +521,8 @@ std::string Csv(const std::vector<Comparison>& comparisons) {
   csv << "framesets,cameras,images,framesets_used,points,who,observations,"
          "iterations,wall_s,cpu_s,ceres_s,wall_s_per_iteration,"
          "initial_rms_px,final_rms_px,max_rotation_error_deg,"
-         "max_center_error_m,termination,linear_solver\n";
+         "max_center_error_m,termination,linear_solver,start_inliers,"
+         "single_observations,behind_camera,reported_rms_px\n";
   for (const Comparison& c : comparisons) {
     for (const SolverRun* run : {&c.ours, &c.colmap}) {
       csv << c.framesets << "," << c.cameras << "," << c.data->num_images << ","
@@ -521,7 +538,10 @@ std::string Csv(const std::vector<Comparison>& comparisons) {
           << "\",\""
           << (run == &c.ours ? "SPARSE_SCHUR (points eliminated)"
                              : c.colmap_linear_solver)
-          << "\"\n";
+          << "\"," << c.data->num_start_inliers << ","
+          << c.data->num_single_observations << "," << run->num_behind << ","
+          << (run->reported_rms_px >= 0 ? Number(run->reported_rms_px) : "")
+          << "\n";
     }
   }
   return csv.str();
@@ -564,8 +584,11 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
          << " | "
          << Fixed(run->wall_seconds / std::max(1, run->num_iterations), 3)
          << " | " << Fixed(run->initial_rms_px, 4) << " -> "
-         << Fixed(run->final_rms_px, 6) << " | "
-         << Fixed(run->max_rotation_error_deg, 4) << " | "
+         << Fixed(run->final_rms_px, 6)
+         << (run->num_behind > 0
+                 ? " (" + std::to_string(run->num_behind) + " behind camera)"
+                 : "")
+         << " | " << Fixed(run->max_rotation_error_deg, 4) << " | "
          << Fixed(1000 * run->max_center_error_m, 3) << " | "
          << run->termination << " |\n";
     }
@@ -587,7 +610,13 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
        << c.colmap_linear_solver << ", ours SPARSE_SCHUR (points eliminated); "
        << "model_converter " << Fixed(c.colmap_io_seconds, 2) << " s; "
        << c.data->num_framesets << " framesets compared, "
-       << c.data->num_dropped_framesets << " dropped\n";
+       << c.data->num_dropped_framesets << " dropped; "
+       << c.data->observations.size() << " of the start's "
+       << c.data->num_start_inliers << " inliers compared ("
+       << c.data->num_single_observations
+       << " of points seen once left out); COLMAP's own final RMS (2 x its "
+          "printed final cost) "
+       << Fixed(c.colmap.reported_rms_px, 6) << " px\n";
   }
   return md.str();
 }
@@ -638,28 +667,33 @@ bool ParseColmapSolverSummary(const std::string& text,
   return true;
 }
 
-double RmsReprojectionError(const std::vector<ObservedPoint>& observations,
-                            const ModelView& view) {
-  if (observations.empty()) return 0;
+ReprojectionRms RmsReprojectionError(
+    const std::vector<ObservedPoint>& observations, const ModelView& view) {
+  ReprojectionRms result;
   double sum = 0;
   for (const ObservedPoint& observation : observations) {
     const auto point = view.points3D.find(observation.point3D_id);
-    if (observation.image < 0 ||
-        observation.image >= static_cast<int>(view.image_cameras.size()) ||
-        observation.image >=
-            static_cast<int>(view.image_cam_from_world.size()) ||
-        point == view.points3D.end()) {
-      return std::numeric_limits<double>::infinity();
-    }
+    const bool known =
+        observation.image >= 0 &&
+        observation.image < static_cast<int>(view.image_cameras.size()) &&
+        observation.image <
+            static_cast<int>(view.image_cam_from_world.size()) &&
+        point != view.points3D.end();
     const Eigen::Vector3d in_camera =
-        view.image_cam_from_world[observation.image] * point->second;
-    if (!(in_camera.z() > 0)) return std::numeric_limits<double>::infinity();
+        known ? view.image_cam_from_world[observation.image] * point->second
+              : Eigen::Vector3d::Zero();
+    if (!(in_camera.z() > 0)) {
+      ++result.num_unusable;
+      continue;
+    }
     sum += (view.image_cameras[observation.image].WorldToImage(
                 in_camera.hnormalized()) -
             observation.point2D)
                .squaredNorm();
+    ++result.num_used;
   }
-  return std::sqrt(sum / observations.size());
+  result.rms_px = result.num_used > 0 ? std::sqrt(sum / result.num_used) : 0;
+  return result;
 }
 
 bool RunColmapRigBaComparison(const ColmapRigBaComparisonOptions& options,
@@ -746,9 +780,11 @@ bool RunColmapRigBaComparison(const ColmapRigBaComparisonOptions& options,
         ok = false;
         break;
       }
-      const double initial_rms = RmsReprojectionError(
-          data->observations,
-          ViewOfCalibration(*data, data->start, StartPoints(*data)));
+      const double initial_rms =
+          RmsReprojectionError(
+              data->observations,
+              ViewOfCalibration(*data, data->start, StartPoints(*data)))
+              .rms_px;
       std::cout << "  " << num_framesets << " x " << num_cameras << ": "
                 << data->observations.size() << " observations, start RMS "
                 << initial_rms << " px; COLMAP ..." << std::endl;

@@ -90,10 +90,16 @@ struct ModelView {
   std::unordered_map<int64_t, Eigen::Vector3d> points3D;
 };
 
-// sqrt(sum |pi(R X + t) - x|^2 / N) over the observations; infinity if one
-// is behind its camera or refers to an unknown image or point, 0 for none.
-double RmsReprojectionError(const std::vector<ObservedPoint>& observations,
-                            const ModelView& view);
+struct ReprojectionRms {
+  // sqrt(sum |pi(R X + t) - x|^2 / N) over the N usable observations (0 for
+  // none).
+  double rms_px = 0;
+  int64_t num_used = 0;
+  // Behind their camera, or of an unknown image or point: not in the RMS.
+  int64_t num_unusable = 0;
+};
+ReprojectionRms RmsReprojectionError(
+    const std::vector<ObservedPoint>& observations, const ModelView& view);
 
 // Runs every comparison and writes the table and the CSV; false with *error
 // on bad options or a failed run.

@@ -101,27 +101,36 @@ TEST(RmsReprojectionError, IsTheRootMeanSquareOverObservations) {
   // Exact: (50, 50) and, in image 1, point 8 at x = 0 -> (50, 50).
   std::vector<ObservedPoint> observations = {{0, 7, Eigen::Vector2d(50, 50)},
                                              {1, 8, Eigen::Vector2d(50, 50)}};
-  EXPECT_NEAR(RmsReprojectionError(observations, view), 0, 1e-12);
+  EXPECT_NEAR(RmsReprojectionError(observations, view).rms_px, 0, 1e-12);
   // Errors of 3-4-5 and 1 px: sqrt((25 + 1) / 2).
   observations[0].point2D = Eigen::Vector2d(53, 54);
   observations[1].point2D = Eigen::Vector2d(50, 49);
-  EXPECT_NEAR(RmsReprojectionError(observations, view), std::sqrt(13.0), 1e-12);
+  EXPECT_NEAR(RmsReprojectionError(observations, view).rms_px, std::sqrt(13.0),
+              1e-12);
   // Point 8 in image 0: x = 100 * 1 / 10 + 50 = 60.
   observations.push_back({0, 8, Eigen::Vector2d(60, 50)});
-  EXPECT_NEAR(RmsReprojectionError(observations, view), std::sqrt(26.0 / 3),
-              1e-12);
-  EXPECT_EQ(RmsReprojectionError({}, view), 0);
+  const ReprojectionRms rms = RmsReprojectionError(observations, view);
+  EXPECT_NEAR(rms.rms_px, std::sqrt(26.0 / 3), 1e-12);
+  EXPECT_EQ(rms.num_used, 3);
+  EXPECT_EQ(rms.num_unusable, 0);
+  EXPECT_EQ(RmsReprojectionError({}, view).rms_px, 0);
 }
 
-TEST(RmsReprojectionError, IsInfiniteForUnusableObservations) {
+TEST(RmsReprojectionError, CountsUnusableObservationsApart) {
   ModelView view = OneCameraView();
-  EXPECT_TRUE(std::isinf(
-      RmsReprojectionError({{0, 9, Eigen::Vector2d(50, 50)}}, view)));
-  EXPECT_TRUE(std::isinf(
-      RmsReprojectionError({{2, 7, Eigen::Vector2d(50, 50)}}, view)));
-  view.points3D[7].z() = -10;  // behind the camera
-  EXPECT_TRUE(std::isinf(
-      RmsReprojectionError({{0, 7, Eigen::Vector2d(50, 50)}}, view)));
+  // An unknown point, an unknown image, then point 7 behind the camera; the
+  // one usable observation is 2 px off.
+  std::vector<ObservedPoint> observations = {{0, 9, Eigen::Vector2d(50, 50)},
+                                             {2, 7, Eigen::Vector2d(50, 50)},
+                                             {1, 8, Eigen::Vector2d(52, 50)}};
+  ReprojectionRms rms = RmsReprojectionError(observations, view);
+  EXPECT_EQ(rms.num_unusable, 2);
+  EXPECT_EQ(rms.num_used, 1);
+  EXPECT_NEAR(rms.rms_px, 2, 1e-12);
+  view.points3D[7].z() = -10;
+  rms = RmsReprojectionError({{0, 7, Eigen::Vector2d(50, 50)}}, view);
+  EXPECT_EQ(rms.num_unusable, 1);
+  EXPECT_EQ(rms.rms_px, 0);
 }
 
 }  // namespace
