@@ -133,5 +133,20 @@ TEST(RmsReprojectionError, CountsUnusableObservationsApart) {
   EXPECT_EQ(rms.rms_px, 0);
 }
 
+TEST(RunColmapRigBaComparison, NamesTheBadOption) {
+  ColmapRigBaComparisonOptions options;
+  options.output_path = ::testing::TempDir() + "/colmap_rig_ba_bad_options";
+  std::string error;
+  options.framesets = "10,x";
+  EXPECT_FALSE(RunColmapRigBaComparison(options, &error));
+  EXPECT_NE(error.find("--framesets"), std::string::npos) << error;
+  options.framesets = "10";
+  options.colmap_executable = "/nonexistent/colmap";
+  EXPECT_FALSE(RunColmapRigBaComparison(options, &error));
+  EXPECT_NE(error.find("--colmap_executable: /nonexistent/colmap"),
+            std::string::npos)
+      << error;
+}
+
 }  // namespace
 }  // namespace rig_calibrator
