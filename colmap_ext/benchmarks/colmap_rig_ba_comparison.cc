@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <limits>
+#include <memory>
 #include <regex>
 #include <sstream>
 #include <thread>
