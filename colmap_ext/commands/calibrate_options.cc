@@ -157,6 +157,10 @@ void AddLocalizationOptions(po::options_description* description,
             &o->guidance.max_line_distance_px,
             "direct mode: largest distance of a guided match from the "
             "point's radial line (pixels)");
+  AddOption(description, "Localization.guided_max_ratio",
+            &o->guidance.max_ratio,
+            "direct mode: Lowe's ratio test of a guided match, against the "
+            "second-nearest point near the same radial line");
   AddOption(description, "Localization.use_database_matches",
             &o->use_database_matches,
             "use matches a COLMAP matcher already stored between rig and map "

@@ -13,9 +13,94 @@
 #include <flann/util/result_set.h>
 #include <flann/util/saving.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <mutex>
 #include <random>
 #include <vector>
+
+namespace rig_calibrator {
+namespace flann_search {
+
+// KDTreeIndex::getNeighbors, once per query, allocates and zeroes a bitset of
+// one bit per indexed descriptor ("visited", so that a leaf reached in two
+// trees is checked once) and reserves a branch heap of one entry per
+// descriptor: at 4e6 descriptors (10^6 map points) 500 kB zeroed and 64 MB
+// reserved (mmap'ed and unmapped) per feature, for a search that visits
+// num_checks (64) leaves. The two classes below replace those two types in
+// kdtree_index.h only (the #defines around its #include).
+
+// The visited set: a bitset kept per thread, all zero between searches; a
+// search records the words it sets and clears only those when it ends, so a
+// query costs O(checks) instead of O(descriptors). getNeighbors creates one
+// per query and never two at once on a thread.
+class ReusedVisitedBitset {
+ public:
+  explicit ReusedVisitedBitset(const size_t size)
+      : words_(ThreadWords()), touched_(ThreadTouched()) {
+    const size_t num_words = size / kWordBits + 1;
+    if (words_.size() < num_words) words_.resize(num_words, 0);
+  }
+  ~ReusedVisitedBitset() {
+    for (const size_t word : touched_) words_[word] = 0;
+    touched_.clear();
+  }
+  ReusedVisitedBitset(const ReusedVisitedBitset&) = delete;
+  ReusedVisitedBitset& operator=(const ReusedVisitedBitset&) = delete;
+
+  bool test(const size_t index) const {
+    return (words_[index / kWordBits] >> (index % kWordBits)) & 1u;
+  }
+  void set(const size_t index) {
+    uint64_t& word = words_[index / kWordBits];
+    if (word == 0) touched_.push_back(index / kWordBits);
+    word |= uint64_t{1} << (index % kWordBits);
+  }
+
+ private:
+  static constexpr size_t kWordBits = 64;
+  static std::vector<uint64_t>& ThreadWords() {
+    thread_local std::vector<uint64_t> words;
+    return words;
+  }
+  static std::vector<size_t>& ThreadTouched() {
+    thread_local std::vector<size_t> touched;
+    return touched;
+  }
+  std::vector<uint64_t>& words_;
+  std::vector<size_t>& touched_;
+};
+
+// flann::Heap without the up-front reserve of `capacity` entries: the
+// vector grows to the branches a search actually pushes (hundreds). Same
+// order and capacity rule, so the same neighbours.
+template <typename T>
+class GrowingHeap {
+ public:
+  explicit GrowingHeap(const int capacity) : capacity_(capacity) {}
+  void insert(const T& value) {
+    if (static_cast<int>(heap_.size()) == capacity_) return;
+    heap_.push_back(value);
+    std::push_heap(heap_.begin(), heap_.end(), Greater());
+  }
+  bool popMin(T& value) {
+    if (heap_.empty()) return false;
+    std::pop_heap(heap_.begin(), heap_.end(), Greater());
+    value = heap_.back();
+    heap_.pop_back();
+    return true;
+  }
+
+ private:
+  struct Greater {
+    bool operator()(const T& a, const T& b) const { return b < a; }
+  };
+  int capacity_;
+  std::vector<T> heap_;
+};
+
+}  // namespace flann_search
+}  // namespace rig_calibrator
 
 // KDTreeIndex::buildIndexImpl shuffles with
 //   std::random_device rd; std::mt19937 g(rd());
@@ -25,7 +110,11 @@
 // the index array in place). std::rand, seeded below, picks the split
 // dimensions.
 #define random_device mt19937
+#define DynamicBitset ::rig_calibrator::flann_search::ReusedVisitedBitset
+#define Heap ::rig_calibrator::flann_search::GrowingHeap
 #include <flann/algorithms/kdtree_index.h>
+#undef Heap
+#undef DynamicBitset
 #undef random_device
 
 namespace rig_calibrator {

@@ -11,8 +11,9 @@
 // other 2D-3D correspondences for the same database. Here the shuffle uses a
 // std::mt19937 with its default seed and std::rand is seeded with `seed`
 // (flann::seed_random) right before the build, under a lock that every build
-// of this class takes. Building once per map costs nothing extra; searching is
-// FLANN's, unchanged.
+// of this class takes. Building once per map costs nothing extra. Searching
+// is FLANN's, with the same neighbours, minus its per-query allocation and
+// zeroing of buffers sized to the whole index (descriptor_kd_forest.cc).
 #pragma once
 
 #include <colmap/feature/types.h>

@@ -77,10 +77,11 @@ bool MapLocalizerOptions::Check(std::string* error) const {
     return fail("index num_trees and num_checks must be >= 1");
   }
   if (guidance.batch_size < 1 || guidance.min_pose_inliers < 5 ||
-      !(guidance.max_line_distance_px > 0)) {
+      !(guidance.max_line_distance_px > 0) ||
+      !(guidance.max_ratio > 0 && guidance.max_ratio <= 1)) {
     return fail(
-        "guidance needs batch_size >= 1, min_pose_inliers >= 5 and "
-        "max_line_distance_px > 0");
+        "guidance needs batch_size >= 1, min_pose_inliers >= 5, "
+        "max_line_distance_px > 0 and max_ratio in (0, 1]");
   }
   if (num_retrieved_images < 1)
     return fail("num_retrieved_images must be >= 1");

@@ -153,7 +153,7 @@ bool MapLocalizer::MatchDirectly(
       if (!near_center_rows.empty()) search_index(near_center_rows);
       RadialGuidedMatchingOptions guided_options;
       guided_options.max_line_distance_px = guidance.max_line_distance_px;
-      guided_options.max_ratio = max_ratio;
+      guided_options.max_ratio = guidance.max_ratio;
       guided_options.max_distance = max_distance;
       const RadialLineIndex line_index(map_, point_index_, point3D_ids,
                                        pose.cam_from_world);
