@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "colmap_ext/benchmarks/child_process.h"
+#include "colmap_ext/benchmarks/runtime_benchmark_options.h"
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
@@ -30,24 +31,6 @@ namespace rig_calibrator {
 namespace {
 
 namespace fs = std::filesystem;
-
-// "10,50,100" -> {10, 50, 100}; false for anything but positive integers.
-bool ParseCountList(const std::string& text, std::vector<int>* values) {
-  values->clear();
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    try {
-      size_t used = 0;
-      const int value = std::stoi(item, &used);
-      if (used != item.size() || value < 1) return false;
-      values->push_back(value);
-    } catch (const std::exception&) {
-      return false;
-    }
-  }
-  return !values->empty();
-}
 
 // The last match of `pattern`'s first group in `text`, or "".
 std::string LastMatch(const std::string& text, const std::string& pattern) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "colmap_ext/localization/point_descriptor_index.h"
 #include "src/synthetic/synthetic_rig.h"
@@ -67,5 +68,10 @@ struct RuntimeBenchmarkOptions {
 
   ChildRequest request;
 };
+
+// A list option such as --framesets: "10,50,100" -> {10, 50, 100}; false
+// for anything but positive integers (benchmarks' own, in
+// runtime_benchmark_runner.cc).
+bool ParseCountList(const std::string& text, std::vector<int>* values);
 
 }  // namespace rig_calibrator

@@ -19,18 +19,6 @@
 #include "src/calibration/pipeline.h"
 
 namespace rig_calibrator {
-namespace {
-
-namespace fs = std::filesystem;
-
-bool WriteText(const std::string& path, const std::string& text) {
-  std::string error;
-  if (!WriteFileAtomically(path, text, &error)) {
-    PrintError(error);
-    return false;
-  }
-  return true;
-}
 
 // "10,50,100" -> {10, 50, 100}; false for anything but positive integers.
 bool ParseCountList(const std::string& text, std::vector<int>* values) {
@@ -48,6 +36,19 @@ bool ParseCountList(const std::string& text, std::vector<int>* values) {
     }
   }
   return !values->empty();
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+bool WriteText(const std::string& path, const std::string& text) {
+  std::string error;
+  if (!WriteFileAtomically(path, text, &error)) {
+    PrintError(error);
+    return false;
+  }
+  return true;
 }
 
 std::string Seconds(double seconds) {
