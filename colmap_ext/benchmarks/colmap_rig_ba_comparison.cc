@@ -89,15 +89,7 @@ bool CalibrateUpToFinalAdjustment(const RigDataset& dataset, int seed,
   options.method = CalibrationMethod::kRadial1D;
   options.seed = static_cast<unsigned int>(seed);
   options.print_progress = false;
-  *calibration = RigCalibration();
-  for (const RigCamera& camera : dataset.cameras) {
-    calibration->cameras.push_back(camera.camera);
-  }
-  calibration->cam_from_rig.assign(dataset.cameras.size(), Rigid3d());
-  calibration->camera_calibrated.assign(dataset.cameras.size(), false);
-  calibration->rig_from_world.assign(dataset.frameset_names.size(),
-                                     std::nullopt);
-  calibration->images.assign(dataset.images.size(), ImageResult());
+  InitializeCalibration(dataset, calibration);
   InitialPoseOptions pose_options = options.initial_pose;
   pose_options.seed = options.seed;
   pose_options.print_progress = false;

@@ -11,21 +11,6 @@
 namespace rig_calibrator {
 namespace {
 
-// The calibration before any stage: the dataset's cameras, nothing posed.
-void InitializeCalibration(const RigDataset& dataset,
-                           RigCalibration* calibration) {
-  const int num_cameras = static_cast<int>(dataset.cameras.size());
-  *calibration = RigCalibration();
-  for (const RigCamera& camera : dataset.cameras) {
-    calibration->cameras.push_back(camera.camera);
-  }
-  calibration->cam_from_rig.assign(num_cameras, Rigid3d());
-  calibration->camera_calibrated.assign(num_cameras, false);
-  calibration->rig_from_world.assign(dataset.frameset_names.size(),
-                                     std::nullopt);
-  calibration->images.assign(dataset.images.size(), ImageResult());
-}
-
 // Paper §3.2: every image localized on its own, with the pose model of the
 // method.
 void EstimateInitialPosesFor(const PipelineOptions& options,

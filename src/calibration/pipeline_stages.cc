@@ -186,6 +186,20 @@ void MedianIntrinsics(const RigDataset& dataset,
 
 }  // namespace
 
+void InitializeCalibration(const RigDataset& dataset,
+                           RigCalibration* calibration) {
+  const int num_cameras = static_cast<int>(dataset.cameras.size());
+  *calibration = RigCalibration();
+  for (const RigCamera& camera : dataset.cameras) {
+    calibration->cameras.push_back(camera.camera);
+  }
+  calibration->cam_from_rig.assign(num_cameras, Rigid3d());
+  calibration->camera_calibrated.assign(num_cameras, false);
+  calibration->rig_from_world.assign(dataset.frameset_names.size(),
+                                     std::nullopt);
+  calibration->images.assign(dataset.images.size(), ImageResult());
+}
+
 bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
                      RigCalibration* calibration, PipelineReport* report) {
   {

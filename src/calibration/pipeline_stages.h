@@ -11,6 +11,10 @@
 
 namespace rig_calibrator {
 
+// The calibration before any stage: the dataset's cameras, nothing posed.
+void InitializeCalibration(const RigDataset& dataset,
+                           RigCalibration* calibration);
+
 // 1dr: robust radial rig initialization, radial bundle adjustment, camera
 // upgrade of every camera; the rig is then anchored at the reference camera.
 bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
