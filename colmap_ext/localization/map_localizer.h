@@ -85,7 +85,7 @@ struct MapLocalizerOptions {
   // scale"): with ratio 0.8 the calibration's worst camera rotation error
   // rose from 0.0053 to 0.0082 deg (unguided); with 0.6 all worst-camera
   // errors are at or below the unguided ones, for 4.5 % fewer
-  // correspondences and ~5x fewer CPU seconds per image (0.5 lost accuracy
+  // correspondences and 4.2x fewer CPU seconds per image (0.5 lost accuracy
   // again, too few correspondences).
   struct Guidance {
     bool enabled = true;  // false: every feature is searched in the index
