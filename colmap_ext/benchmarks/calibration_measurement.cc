@@ -25,7 +25,6 @@ bool MeasureCalibration(const RuntimeBenchmarkOptions& options,
   pipeline_options.num_threads = options.num_threads;
   pipeline_options.seed = static_cast<unsigned int>(options.seed);
   pipeline_options.print_progress = false;
-  pipeline_options.deterministic_solvers = options.deterministic_solvers;
   pipeline_options.final_bundle_adjustment.refine_points =
       options.refine_points;
   if (!rig_options.Check(error)) return false;

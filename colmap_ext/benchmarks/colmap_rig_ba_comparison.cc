@@ -466,11 +466,11 @@ bool RunOurSide(const ColmapRigBaComparisonOptions& options, int num_threads,
   run->num_iterations = summary.num_iterations;
   run->num_observations = summary.num_residuals;
   run->termination =
-      summary.ceres_report.find("CONVERGENCE") != std::string::npos
-          ? (summary.ceres_report.find("NO_CONVERGENCE") != std::string::npos
+      summary.solver_report.find("CONVERGENCE") != std::string::npos
+          ? (summary.solver_report.find("NO_CONVERGENCE") != std::string::npos
                  ? "No convergence"
                  : "Convergence")
-          : summary.ceres_report;
+          : summary.solver_report;
   const ReprojectionRms rms = RmsReprojectionError(
       data.observations,
       ViewOfCalibration(data, calibration, calibration.refined_points3D));

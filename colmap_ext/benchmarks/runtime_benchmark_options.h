@@ -34,9 +34,6 @@ struct RuntimeBenchmarkOptions {
   // As `rig_calibrator calibrate` (--RigCalibrator.refine_points, on by
   // default): the final bundle adjustment also refines the map points.
   bool refine_points = true;
-  // As the calibrate command (--RigCalibrator.deterministic_solvers, on by
-  // default): the bundle adjustments give the same bits on any thread count.
-  bool deterministic_solvers = true;
   // The synthetic data of the calibration runs: points_per_image, noise_px,
   // outlier_ratio, missing_image_ratio, map_point_noise (issue 14's
   // scenario: 300, 0.5 px, 30 % wrong matches, 10 % missing images, map

@@ -307,9 +307,7 @@ std::string RuntimeMarkdown(
     md << "## Before / after\n\n"
        << "Each configuration ran with `" << options.baseline_executable
        << "` (before) and then with this build (after), on the same data, "
-          "one after the other in this run"
-       << (options.deterministic_solvers ? "" : " (deterministic_solvers 0)")
-       << ". Ratios > 1: the after build is faster.\n\n"
+          "one after the other in this run. Ratios > 1: the after build is faster.\n\n"
        << CalibrationBeforeAfterMarkdown(before_runs, calibration_runs);
   }
   if (!localization_runs.empty()) {

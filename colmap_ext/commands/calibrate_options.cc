@@ -114,13 +114,7 @@ void AddRigCalibratorOptions(po::options_description* description,
   AddOption(description, "RigCalibrator.min_num_inliers", &o->min_num_inliers,
             "images with fewer 2D-3D inliers are not localized");
   AddOption(description, "RigCalibrator.num_threads", &o->num_threads,
-            "-1: all cores");
-  AddOption(description, "RigCalibrator.deterministic_solvers",
-            &o->deterministic_solvers,
-            "1: the bundle adjustments run on one thread, so that a seed "
-            "gives bit-identical results for any num_threads; 0: on "
-            "num_threads (faster on large rigs, results differ between runs "
-            "by <= 1e-9 relative)");
+            "-1: all cores (the result does not depend on the count)");
   AddOption(description, "RigCalibrator.seed", &o->seed,
             "random seed (results are deterministic for a seed)");
 }
@@ -219,7 +213,6 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
     return false;
   }
   pipeline->num_threads = options->num_threads;
-  pipeline->deterministic_solvers = options->deterministic_solvers;
   pipeline->seed = static_cast<unsigned int>(options->seed);
   pipeline->initial_pose.radial.max_error_px = options->radial_max_error_px;
   pipeline->initial_pose.min_num_inliers = options->min_num_inliers;

@@ -55,7 +55,6 @@ struct CalibrateOptions {
   double loss_scale_px = 1.0;
   int min_num_inliers = 15;
   int num_threads = -1;
-  bool deterministic_solvers = true;
   int seed = 0;
 
   std::string localization_mode = "direct";

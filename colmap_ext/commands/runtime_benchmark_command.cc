@@ -43,9 +43,6 @@ void AddCalibrationRunOptions(po::options_description* description,
   AddOption(description, "refine_points", &o->refine_points,
             "the final bundle adjustment also refines the map points (the "
             "calibrate command's default)");
-  AddOption(description, "deterministic_solvers", &o->deterministic_solvers,
-            "bundle adjustments bit-identical on any thread count (the "
-            "calibrate command's default)");
   AddSyntheticDataOptions(description, &o->data);
   AddOption(description, "map_point_noise", &o->data.map_point_noise,
             "error of the map points given to the calibration (map units, "

@@ -71,21 +71,21 @@ constexpr double kPruningFunctionTolerance = 1e-3;
 bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
                       RigAdjustment* adjustment,
                       FinalBundleAdjustmentSummary* result) {
-  ceres::Solver::Summary ceres_summary;
+  BundleLevenbergMarquardtSummary solver_summary;
   bool nothing_pruned = false;
   for (int round = 0;; ++round) {
     const bool last = round >= options.num_pruning_rounds;
     if (!adjustment->Solve(last || nothing_pruned ? kFunctionTolerance
                                                   : kPruningFunctionTolerance,
-                           &ceres_summary)) {
+                           &solver_summary)) {
       return false;
     }
     result->num_residuals = static_cast<int>(adjustment->NumObservations());
     result->num_map_residuals =
         static_cast<int>(adjustment->NumMapObservationsInProblem());
-    result->num_iterations += ceres_summary.num_successful_steps +
-                              ceres_summary.num_unsuccessful_steps;
-    result->ceres_report = ceres_summary.BriefReport();
+    result->num_iterations += solver_summary.num_successful_steps +
+                              solver_summary.num_unsuccessful_steps;
+    result->solver_report = solver_summary.BriefReport();
     if (last || nothing_pruned) {
       return true;
     }

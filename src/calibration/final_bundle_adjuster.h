@@ -13,11 +13,12 @@
 // are pruned relative to each camera's robust residual spread and the problem
 // is solved again.
 //
-// Speed: each frameset's rig pose is seen only through the few shared
-// camera blocks, so the rig poses are the eliminated group of the Schur
-// complement and the reduced system (intrinsics and extrinsics of the rig
-// cameras) is tiny; the cost is residual and Jacobian evaluation, which Ceres
-// spreads over all threads.
+// Solver: the problem's own Levenberg-Marquardt
+// (src/solvers/bundle_levenberg_marquardt.h), which eliminates the refined
+// points by their 3 x 3 blocks and factorizes the reduced system over the rig
+// poses, map poses and cameras (a camera's cam_from_rig and intrinsics one
+// block) with a sparse Cholesky; it uses every thread and its result does
+// not depend on their count.
 #pragma once
 
 #include <string>
@@ -85,8 +86,9 @@ struct FinalBundleAdjustmentOptions {
   // Prune-and-resolve rounds after the first solve; stops early when a round
   // prunes nothing. 0: no pruning.
   int num_pruning_rounds = 2;
-  int num_threads = -1;         // Ceres threads (-1: all cores)
-  bool print_progress = false;  // Ceres per-iteration progress
+  // Solver threads (-1: all cores); the result does not depend on them.
+  int num_threads = -1;
+  bool print_progress = false;  // per-iteration progress on stdout
 };
 
 struct FinalBundleAdjustmentSummary {
@@ -94,15 +96,16 @@ struct FinalBundleAdjustmentSummary {
   // at the initial estimate, and over the final inliers at the result.
   double initial_rms_px = 0, final_rms_px = 0;
   // Observations (2-vector residual blocks) in the last solve; observations
-  // given as inliers and rejected (pruned, behind a camera, too far); Ceres
-  // iterations summed over all solves; wall time of AdjustRig.
+  // given as inliers and rejected (pruned, behind a camera, too far);
+  // Levenberg-Marquardt iterations summed over all solves; wall time of
+  // AdjustRig.
   int num_residuals = 0, num_outliers = 0, num_iterations = 0;
   double seconds = 0;
   // The map images' observations in the problem (of refined points): count
   // in the last solve, rejected, RMS at the initial estimate and the result.
   int num_map_residuals = 0, num_map_outliers = 0;
   double map_initial_rms_px = 0, map_final_rms_px = 0;
-  std::string ceres_report;  // Ceres BriefReport of the last solve
+  std::string solver_report;  // BriefReport of the last solve
 };
 
 // Minimizes the objective above over the correspondences with
@@ -114,7 +117,7 @@ struct FinalBundleAdjustmentSummary {
 // dataset, map_cameras, map_cam_from_world and map_observation_rejected. On
 // bad input (a dataset that
 // ValidateDataset rejects, inconsistent sizes, unknown camera model, no
-// usable observation) or a Ceres failure it
+// usable observation) or a solver failure it
 // logs the reason, leaves `calibration` unchanged and returns false.
 // `summary` may be null.
 bool AdjustRig(const FinalBundleAdjustmentOptions& options,

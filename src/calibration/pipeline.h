@@ -48,23 +48,13 @@ struct PipelineOptions {
   // handed to the camera upgrade (pixels).
   double upgrade_radial_max_error_px = 8.0;
 
-  // Threads of the stages that split their work by image or camera (their
-  // results do not depend on the count) and, with `deterministic_solvers`
-  // off, of Ceres' solvers.
+  // Threads of every stage. The results do not depend on the count: the
+  // stages split their work by image or camera, and the bundle adjustments'
+  // solver (bundle_levenberg_marquardt.h) adds its parts in a fixed order,
+  // so the calibration is bit-identical for a seed, whatever num_threads.
   int num_threads = -1;
-  // Ceres adds up costs, gradients and Schur complements in the order its
-  // threads finish, so a multithreaded solve differs between two runs in the
-  // last digits (tests/e2e/determinism_e2e.sh: <= 1e-9 relative). On, the
-  // bundle adjustments run on one thread and the calibration is bit-identical
-  // for a seed, whatever num_threads.
-  bool deterministic_solvers = true;
   unsigned int seed = 0;
   bool print_progress = true;
-
-  // The thread count of the bundle adjustments.
-  int SolverNumThreads() const {
-    return deterministic_solvers ? 1 : num_threads;
-  }
 };
 
 // Calibrates every camera of `dataset` (intrinsics and cam_from_rig) and the

@@ -217,7 +217,7 @@ bool RunRadialStages(const PipelineOptions& options, const RigDataset& dataset,
     StageTimer stage("Radial bundle adjustment", options.print_progress,
                      report);
     RadialBundleAdjustmentOptions ba_options = options.radial_bundle_adjustment;
-    ba_options.num_threads = options.SolverNumThreads();
+    ba_options.num_threads = options.num_threads;
     RadialBundleAdjustmentSummary summary;
     if (!AdjustRadialRig(ba_options, dataset, calibration, &summary)) {
       report->error = "the radial bundle adjustment failed (see above)";
@@ -281,7 +281,8 @@ FinalBundleAdjustmentOptions FinalBundleAdjustmentOptionsFor(
     const PipelineOptions& options, CalibrationMethod method,
     const RigDataset& dataset) {
   FinalBundleAdjustmentOptions ba_options = options.final_bundle_adjustment;
-  ba_options.num_threads = options.SolverNumThreads();
+  // Its solver's result does not depend on the thread count.
+  ba_options.num_threads = options.num_threads;
   // Map images can all be missing although there is a map (e.g. its cameras
   // are of models this build cannot project): nothing to adjust then.
   if (dataset.map_images.empty()) {

@@ -2,18 +2,19 @@
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
-#include <colmap/util/threading.h>
 #include <glog/logging.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <vector>
 
 #include "src/calibration/principal_axes.h"
 #include "src/geometry/radial_rig_cost_function.h"
+#include "src/solvers/bundle_levenberg_marquardt.h"
 
 namespace rig_calibrator {
 namespace {
@@ -94,79 +95,76 @@ std::vector<Observation> KeepDeterminedFramesets(
   return kept;
 }
 
-// One Levenberg-Marquardt solve over the observations. Gauge: the reference
-// camera's pose is constant, every camera's tz is held, and so is the t_z of
-// one rig pose (the rig origin's slide along the reference axis moves every
-// rig pose's t_z; holding one removes that null direction). Rig poses form
-// the eliminated group of the Schur complement: no residual links two. The
-// principal points of the cameras whose refinement holds them stay constant.
-ceres::Solver::Summary Solve(const RadialBundleAdjustmentOptions& options,
-                             const std::vector<Observation>& observations,
-                             int reference_camera,
-                             const std::vector<RigCamera>& cameras,
-                             Parameters* parameters) {
+// One Levenberg-Marquardt solve over the observations
+// (bundle_levenberg_marquardt.h, no points: every rig pose is a block row of
+// the reduced system, which the sparse Cholesky's ordering eliminates
+// first, as no residual links two). Gauge: the reference camera's pose is
+// constant, every camera's tz is held, and so is the t_z of one rig pose
+// (the rig origin's slide along the reference axis moves every rig pose's
+// t_z; holding one removes that null direction). The principal points of
+// the cameras whose refinement holds them stay constant. A camera's
+// cam_from_rig and principal point are one block row.
+BundleLevenbergMarquardtSummary Solve(
+    const RadialBundleAdjustmentOptions& options,
+    const std::vector<Observation>& observations, int reference_camera,
+    const std::vector<RigCamera>& cameras, Parameters* parameters) {
   const int num_cameras = parameters->cam_from_rig.size();
   const int num_framesets = parameters->rig_from_world.size();
-  ceres::Problem problem;
-  ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
   std::vector<char> cam_added(num_cameras, 0);
   std::vector<char> rig_added(num_framesets, 0);
   for (const Observation& observation : observations) {
-    problem.AddResidualBlock(
-        new RadialRigCostFunction(observation.point2D, observation.point3D),
-        loss, parameters->cam_from_rig[observation.camera].data(),
-        parameters->rig_from_world[observation.frameset].data(),
-        parameters->principal_points[observation.camera].data());
     cam_added[observation.camera] = 1;
     rig_added[observation.frameset] = 1;
   }
-
-  auto* ordering = new ceres::ParameterBlockOrdering;
+  BundleLevenbergMarquardtOptions solver_options;
+  solver_options.max_num_iterations = options.max_num_iterations;
+  // Noisy problems stop on the relative cost change (1e-6); this lets exact
+  // ones converge to the last digits of map-unit poses.
+  solver_options.parameter_tolerance = 1e-10;
+  solver_options.num_threads = options.num_threads;
+  solver_options.print_progress = options.print_progress;
+  BundleLevenbergMarquardt solver(solver_options);
+  const ceres::SubsetManifold tz_held(6, {5});
+  int group = 0;
   bool tz_gauge_held = false;
   for (int j = 0; j < num_framesets; ++j) {
     if (!rig_added[j]) continue;
-    ordering->AddElementToGroup(parameters->rig_from_world[j].data(), 0);
-    if (!tz_gauge_held) {
-      problem.SetManifold(parameters->rig_from_world[j].data(),
-                          new ceres::SubsetManifold(6, {5}));
-      tz_gauge_held = true;
-    }
+    solver.AddParameterBlock(parameters->rig_from_world[j].data(), 6,
+                             tz_gauge_held ? nullptr : &tz_held, group++);
+    tz_gauge_held = true;
   }
-  // Ceres lists a group's blocks by address: one group per camera block, so
-  // that the reduced system's order does not depend on where the heap put
-  // the two vectors (rig_from_world is one vector, in frameset order).
   for (int i = 0; i < num_cameras; ++i) {
     if (!cam_added[i]) continue;
-    ordering->AddElementToGroup(parameters->cam_from_rig[i].data(), 1 + 2 * i);
-    ordering->AddElementToGroup(parameters->principal_points[i].data(),
-                                2 + 2 * i);
-    if (i == reference_camera) {
-      problem.SetParameterBlockConstant(parameters->cam_from_rig[i].data());
-    } else {
-      problem.SetManifold(parameters->cam_from_rig[i].data(),
-                          new ceres::SubsetManifold(6, {5}));
+    bool in_group = false;
+    if (i != reference_camera) {
+      solver.AddParameterBlock(parameters->cam_from_rig[i].data(), 6, &tz_held,
+                               group);
+      in_group = true;
     }
-    if (!options.refine_principal_points ||
-        !cameras[i].refinement.principal_point) {
-      problem.SetParameterBlockConstant(parameters->principal_points[i].data());
+    if (options.refine_principal_points &&
+        cameras[i].refinement.principal_point) {
+      solver.AddParameterBlock(parameters->principal_points[i].data(), 2,
+                               nullptr, group);
+      in_group = true;
     }
+    group += in_group ? 1 : 0;
   }
-
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering.reset(ordering);
-  solver_options.max_num_iterations = options.max_num_iterations;
-  // Noisy problems stop on the relative cost change (Ceres' default 1e-6);
-  // this lets exact ones converge to the last digits of map-unit poses.
-  solver_options.parameter_tolerance = 1e-10;
-  solver_options.num_threads =
-      colmap::GetEffectiveNumThreads(options.num_threads);
-  solver_options.minimizer_progress_to_stdout = options.print_progress;
-  solver_options.logging_type =
-      options.print_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-  ceres::Solver::Summary solver_summary;
-  ceres::Solve(solver_options, &problem, &solver_summary);
-  return solver_summary;
+  const ceres::CauchyLoss loss(options.loss_scale_px);
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  costs.reserve(observations.size());
+  for (const Observation& observation : observations) {
+    costs.push_back(std::make_unique<RadialRigCostFunction>(
+        observation.point2D, observation.point3D));
+    solver.AddResidualBlock(
+        costs.back().get(), &loss,
+        {parameters->cam_from_rig[observation.camera].data(),
+         parameters->rig_from_world[observation.frameset].data(),
+         parameters->principal_points[observation.camera].data()});
+  }
+  BundleLevenbergMarquardtSummary summary;
+  solver.Solve(&summary);
+  VLOG(1) << "Radial bundle adjustment: " << summary.BriefReport();
+  return summary;
 }
 
 bool ObservesReference(const std::vector<Observation>& observations,
@@ -396,9 +394,10 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   // correspondences within max_radial_error_px are dropped whole (a few of a
   // wrong image's points always fall near the predicted lines), the
   // remaining correspondences beyond it too, and the rest solved again.
-  ceres::Solver::Summary solver_summary =
+  BundleLevenbergMarquardtSummary solver_summary =
       Solve(options, observations, reference, dataset.cameras, &parameters);
-  int num_iterations = solver_summary.iterations.size();
+  int num_iterations = solver_summary.num_successful_steps +
+                       solver_summary.num_unsuccessful_steps;
   int num_outliers = 0;
   if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
     const std::vector<Observation> inliers =
@@ -412,7 +411,8 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
       }
       solver_summary =
           Solve(options, observations, reference, dataset.cameras, &parameters);
-      num_iterations += solver_summary.iterations.size();
+      num_iterations += solver_summary.num_successful_steps +
+                        solver_summary.num_unsuccessful_steps;
     }
   }
   if (!solver_summary.IsSolutionUsable()) {

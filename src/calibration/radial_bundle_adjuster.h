@@ -38,7 +38,7 @@ struct RadialBundleAdjustmentOptions {
   // against the truth. 0: all.
   int max_correspondences_per_image = 100;
   int num_threads = -1;
-  bool print_progress = false;  // Ceres per-iteration progress on stdout
+  bool print_progress = false;  // per-iteration progress on stdout
 };
 
 struct RadialBundleAdjustmentSummary {
@@ -65,8 +65,8 @@ struct RadialBundleAdjustmentSummary {
 // correspondences are those selected by calibration->images[k].inlier_mask
 // of images of calibrated cameras whose frameset has a rig pose; the
 // observed points are centered on calibration->cameras[i]'s principal point.
-// Rig poses are eliminated first (Schur complement); Ceres runs on
-// num_threads threads. Correspondences with a radial error above
+// The solver (bundle_levenberg_marquardt.h) runs on num_threads threads, with
+// the same result on any count. Correspondences with a radial error above
 // max_radial_error_px after a first solve, and mostly-outlier images, are
 // dropped for a second one.
 // Returns false, with calibration unchanged and the reason in

@@ -4,7 +4,7 @@
 // refined. Internal to AdjustRig; split over
 //   rig_adjustment.cc           state, evaluation, point selection, results,
 //   rig_adjustment_outliers.cc  outlier pruning,
-//   rig_adjustment_problem.cc   the Ceres problem and its solve.
+//   rig_adjustment_problem.cc   the problem and its solve.
 #pragma once
 
 #include <ceres/ceres.h>
@@ -16,6 +16,7 @@
 
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/solvers/bundle_levenberg_marquardt.h"
 
 namespace rig_calibrator {
 
@@ -65,8 +66,9 @@ class RigAdjustment {
 
   // Builds the problem over the current observations and solves it, until
   // an iteration lowers the cost by less than function_tolerance of it.
-  // False (logged) when Ceres finds no usable solution.
-  bool Solve(double function_tolerance, ceres::Solver::Summary* summary);
+  // False (logged) when the solver finds no usable solution.
+  bool Solve(double function_tolerance,
+             BundleLevenbergMarquardtSummary* summary);
 
   // Writes the estimate and the per-image results (see AdjustRig).
   void WriteTo(RigCalibration* calibration) const;
@@ -118,10 +120,10 @@ class RigAdjustment {
   std::vector<double> MaxErrorPerSlot(
       const std::vector<std::pair<int, ObservationError>>& errors) const;
 
-  void AddResidualBlocks(ceres::Problem* problem);
-  void SetUpParameterBlocks(ceres::Problem* problem);
-  ceres::Solver::Options SolverOptions(const ceres::Problem& problem,
-                                       double function_tolerance);
+  void AddParameterBlocks(BundleLevenbergMarquardt* solver);
+  void AddResidualBlocks(
+      BundleLevenbergMarquardt* solver,
+      std::vector<std::unique_ptr<ceres::CostFunction>>* costs);
 
   const FinalBundleAdjustmentOptions& options_;
   const RigDataset& dataset_;
@@ -143,8 +145,7 @@ class RigAdjustment {
   PoseParams identity_pose_ = {1, 0, 0, 0, 0, 0, 0};
   // By point3D_id: the map positions. The points being refined are one
   // vector in increasing point3D_id order (refined_point_index_: id -> slot),
-  // so that their parameter blocks lie in a fixed address order, which is
-  // the order Ceres eliminates them in (SolverOptions).
+  // the order in which the solver is given them.
   std::unordered_map<int64_t, Eigen::Vector3d> map_points_;
   std::vector<Eigen::Vector3d> refined_points_;
   std::unordered_map<int64_t, size_t> refined_point_index_;
@@ -152,7 +153,7 @@ class RigAdjustment {
   Eigen::Vector3d* RefinedPoint(int64_t point3D_id);
   const Eigen::Vector3d* RefinedPoint(int64_t point3D_id) const;
   bool has_fixed_points_ = false;
-  // Ceres does not own these; they outlive every problem built here.
+  // The solver does not own these; they outlive every solve.
   std::unique_ptr<ceres::LossFunction> loss_;
   std::unique_ptr<ceres::Manifold> pose_manifold_;
   std::vector<std::unique_ptr<ceres::Manifold>> intrinsics_manifolds_;

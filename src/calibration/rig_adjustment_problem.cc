@@ -1,12 +1,9 @@
-// The Ceres problem of the final bundle adjustment: one RigReprojectionCost
-// per observation (a map image's: its cam_from_world as the "rig" pose, a
-// constant identity cam_from_rig), the blocks that are held constant or partly
-// constant, and the solver set-up (Schur elimination of the rig poses or map
-// points).
+// The problem of the final bundle adjustment: one RigReprojectionCost per
+// observation (a map image's: its cam_from_world as the "rig" pose, a
+// constant identity cam_from_rig), the blocks that are refined, held or
+// partly held, and its solve by BundleLevenbergMarquardt with the refined
+// points eliminated.
 #include <glog/logging.h>
-
-#include <algorithm>
-#include <thread>
 
 #include "src/calibration/rig_adjustment.h"
 #include "src/geometry/rig_reprojection_cost.h"
@@ -14,24 +11,32 @@
 namespace rig_calibrator {
 
 bool RigAdjustment::Solve(double function_tolerance,
-                          ceres::Solver::Summary* summary) {
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+                          BundleLevenbergMarquardtSummary* summary) {
   if (options_.refine_points) {
     SelectRefinedPoints();
   }
-  AddResidualBlocks(&problem);
-  SetUpParameterBlocks(&problem);
-  const ceres::Solver::Options solver_options =
-      SolverOptions(problem, function_tolerance);
-  VLOG(1) << "Final bundle adjustment: " << problem.NumResidualBlocks()
-          << " observations (" << problem.NumResiduals() << " residuals), "
-          << problem.NumParameterBlocks() << " parameter blocks";
-  ceres::Solve(solver_options, &problem, summary);
-  VLOG(1) << summary->BriefReport();
-  VLOG(1) << summary->FullReport();
+  BundleLevenbergMarquardtOptions solver_options;
+  solver_options.max_num_iterations = options_.max_num_iterations;
+  solver_options.function_tolerance = function_tolerance;
+  // Exact data converges quadratically; a parameter tolerance relative to
+  // the whole parameter vector (dominated by the focal lengths) of Ceres'
+  // default 1e-8 would stop a few digits short.
+  solver_options.parameter_tolerance = 1e-12;
+  solver_options.num_threads = options_.num_threads;
+  solver_options.print_progress = options_.print_progress;
+  BundleLevenbergMarquardt solver(solver_options);
+  AddParameterBlocks(&solver);
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  AddResidualBlocks(&solver, &costs);
+  VLOG(1) << "Final bundle adjustment: " << costs.size() << " observations";
+  solver.Solve(summary);
+  VLOG(1) << summary->BriefReport() << "; " << summary->seconds
+          << " s: structure " << summary->structure_seconds << " s, evaluation "
+          << summary->evaluation_seconds << " s, reduced system "
+          << summary->schur_seconds << " s, factorization "
+          << summary->factorization_seconds << " s; reduced system "
+          << summary->reduced_system_size << " unknowns, "
+          << summary->num_points << " points";
   if (!summary->IsSolutionUsable()) {
     LOG(ERROR) << "Final bundle adjustment failed: " << summary->message;
     return false;
@@ -39,8 +44,11 @@ bool RigAdjustment::Solve(double function_tolerance,
   return true;
 }
 
-void RigAdjustment::AddResidualBlocks(ceres::Problem* problem) {
+void RigAdjustment::AddResidualBlocks(
+    BundleLevenbergMarquardt* solver,
+    std::vector<std::unique_ptr<ceres::CostFunction>>* costs) {
   has_fixed_points_ = false;
+  costs->reserve(observations_.size());
   for (const Observation& observation : observations_) {
     const RigImage& image = dataset_.images[observation.image];
     const Correspondence& correspondence = CorrespondenceOf(observation);
@@ -48,74 +56,88 @@ void RigAdjustment::AddResidualBlocks(ceres::Problem* problem) {
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
     if (IsPointRefined(correspondence)) {
-      problem->AddResidualBlock(
-          CreateRigReprojectionCost(camera.ModelId(), correspondence.point2D,
-                                    nullptr),
-          loss_.get(), rig_from_world, cam_from_rig, camera.ParamsData(),
-          RefinedPoint(correspondence.point3D_id)->data());
+      costs->emplace_back(CreateRigReprojectionCost(
+          camera.ModelId(), correspondence.point2D, nullptr));
+      solver->AddResidualBlock(
+          costs->back().get(), loss_.get(),
+          {rig_from_world, cam_from_rig, camera.ParamsData(),
+           RefinedPoint(correspondence.point3D_id)->data()});
     } else {
       has_fixed_points_ = true;
-      problem->AddResidualBlock(
-          CreateRigReprojectionCost(camera.ModelId(), correspondence.point2D,
-                                    &correspondence.point3D),
-          loss_.get(), rig_from_world, cam_from_rig, camera.ParamsData());
+      costs->emplace_back(CreateRigReprojectionCost(
+          camera.ModelId(), correspondence.point2D, &correspondence.point3D));
+      solver->AddResidualBlock(
+          costs->back().get(), loss_.get(),
+          {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
   }
   for (const MapObservationRef& observation : MapObservationsInProblem()) {
     const MapObservation& map_observation = MapObservationOf(observation);
     colmap::Camera& camera =
         map_cameras_[dataset_.map_images[observation.image].camera_index];
-    problem->AddResidualBlock(
-        CreateRigReprojectionCost(camera.ModelId(), map_observation.point2D,
-                                  nullptr),
-        loss_.get(), map_cam_from_world_[observation.image].data(),
-        identity_pose_.data(), camera.ParamsData(),
-        RefinedPoint(map_observation.point3D_id)->data());
+    costs->emplace_back(CreateRigReprojectionCost(
+        camera.ModelId(), map_observation.point2D, nullptr));
+    solver->AddResidualBlock(
+        costs->back().get(), loss_.get(),
+        {map_cam_from_world_[observation.image].data(), identity_pose_.data(),
+         camera.ParamsData(),
+         RefinedPoint(map_observation.point3D_id)->data()});
     has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
   }
 }
 
-void RigAdjustment::SetUpParameterBlocks(ceres::Problem* problem) {
-  if (problem->HasParameterBlock(identity_pose_.data())) {
-    problem->SetParameterBlockConstant(identity_pose_.data());
+// Groups (rows of the reduced system): every refined rig pose and map pose
+// on its own, every rig camera's cam_from_rig and intrinsics together (an
+// observation then couples two groups, not three), every refined map
+// camera's intrinsics. Blocks that are not added are held constant. The
+// points are added in point3D_id order.
+void RigAdjustment::AddParameterBlocks(BundleLevenbergMarquardt* solver) {
+  // Only the blocks that the observations use.
+  std::vector<char> frameset_used(rig_from_world_.size(), 0);
+  std::vector<char> camera_used(cameras_.size(), 0);
+  for (const Observation& observation : observations_) {
+    const RigImage& image = dataset_.images[observation.image];
+    frameset_used[image.frameset_index] = 1;
+    camera_used[image.camera_index] = 1;
   }
-  for (PoseParams& pose : map_cam_from_world_) {
-    if (problem->HasParameterBlock(pose.data())) {
-      if (options_.refine_map) {
-        problem->SetManifold(pose.data(), pose_manifold_.get());
-      } else {
-        problem->SetParameterBlockConstant(pose.data());
-      }
+  std::vector<char> map_image_used(map_cam_from_world_.size(), 0);
+  std::vector<char> map_camera_used(map_cameras_.size(), 0);
+  for (const MapObservationRef& observation : MapObservationsInProblem()) {
+    map_image_used[observation.image] = 1;
+    map_camera_used[dataset_.map_images[observation.image].camera_index] = 1;
+  }
+  int group = 0;
+  if (options_.refine_rig_poses) {
+    for (size_t frameset = 0; frameset < rig_from_world_.size(); ++frameset) {
+      if (!frameset_used[frameset]) continue;
+      solver->AddParameterBlock(rig_from_world_[frameset].data(), 7,
+                                pose_manifold_.get(), group++);
     }
   }
-  for (colmap::Camera& camera : map_cameras_) {
-    if (problem->HasParameterBlock(camera.ParamsData()) &&
-        !(options_.refine_map && options_.refine_map_intrinsics)) {
-      problem->SetParameterBlockConstant(camera.ParamsData());
+  if (options_.refine_map) {
+    for (size_t image = 0; image < map_cam_from_world_.size(); ++image) {
+      if (!map_image_used[image]) continue;
+      solver->AddParameterBlock(map_cam_from_world_[image].data(), 7,
+                                pose_manifold_.get(), group++);
+    }
+    for (size_t camera = 0;
+         options_.refine_map_intrinsics && camera < map_cameras_.size();
+         ++camera) {
+      if (!map_camera_used[camera]) continue;
+      solver->AddParameterBlock(
+          map_cameras_[camera].ParamsData(),
+          static_cast<int>(map_cameras_[camera].NumParams()), nullptr, group++);
     }
   }
-  for (PoseParams& pose : rig_from_world_) {
-    if (problem->HasParameterBlock(pose.data())) {
-      if (options_.refine_rig_poses) {
-        problem->SetManifold(pose.data(), pose_manifold_.get());
-      } else {
-        problem->SetParameterBlockConstant(pose.data());
-      }
-    }
-  }
+  intrinsics_manifolds_.clear();
   for (size_t camera = 0; camera < cameras_.size(); ++camera) {
-    double* pose = cam_from_rig_[camera].data();
-    if (problem->HasParameterBlock(pose)) {
-      if (options_.refine_extrinsics &&
-          static_cast<int>(camera) != dataset_.reference_camera) {
-        problem->SetManifold(pose, pose_manifold_.get());
-      } else {
-        problem->SetParameterBlockConstant(pose);
-      }
-    }
-    double* params = cameras_[camera].ParamsData();
-    if (!problem->HasParameterBlock(params)) {
-      continue;
+    if (!camera_used[camera]) continue;
+    bool in_group = false;
+    if (options_.refine_extrinsics &&
+        static_cast<int>(camera) != dataset_.reference_camera) {
+      solver->AddParameterBlock(cam_from_rig_[camera].data(), 7,
+                                pose_manifold_.get(), group);
+      in_group = true;
     }
     const IntrinsicsRefinement method_refinement = {
         options_.refine_focal_length, options_.refine_principal_point,
@@ -124,115 +146,22 @@ void RigAdjustment::SetUpParameterBlocks(ceres::Problem* problem) {
         cameras_[camera],
         method_refinement.And(dataset_.cameras[camera].refinement));
     const int num_params = static_cast<int>(cameras_[camera].NumParams());
-    if (static_cast<int>(constant_params.size()) == num_params) {
-      problem->SetParameterBlockConstant(params);
-    } else if (!constant_params.empty()) {
-      intrinsics_manifolds_.push_back(
-          std::make_unique<ceres::SubsetManifold>(num_params, constant_params));
-      problem->SetManifold(params, intrinsics_manifolds_.back().get());
+    if (static_cast<int>(constant_params.size()) < num_params) {
+      const ceres::Manifold* manifold = nullptr;
+      if (!constant_params.empty()) {
+        intrinsics_manifolds_.push_back(std::make_unique<ceres::SubsetManifold>(
+            num_params, constant_params));
+        manifold = intrinsics_manifolds_.back().get();
+      }
+      solver->AddParameterBlock(cameras_[camera].ParamsData(), num_params,
+                                manifold, group);
+      in_group = true;
     }
+    group += in_group ? 1 : 0;
   }
-}
-
-ceres::Solver::Options RigAdjustment::SolverOptions(
-    const ceres::Problem& problem, double function_tolerance) {
-  ceres::Solver::Options solver_options;
-  solver_options.max_num_iterations = options_.max_num_iterations;
-  solver_options.num_threads =
-      options_.num_threads > 0
-          ? options_.num_threads
-          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  solver_options.minimizer_progress_to_stdout = options_.print_progress;
-  solver_options.logging_type =
-      options_.print_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-  // Exact data converges quadratically; the default parameter tolerance
-  // (relative to the whole parameter vector, dominated by the focal lengths)
-  // would stop a few digits short.
-  solver_options.parameter_tolerance = 1e-12;
-  solver_options.function_tolerance = function_tolerance;
-
-  // Schur elimination group: the variable points when refined (each is seen
-  // by several framesets, so the rig poses cannot share the group: the group
-  // must be an independent set), else the variable rig poses (each seen only
-  // through the shared camera blocks, leaving a tiny dense reduced system).
-  //
-  // Ceres lists the blocks of one ordering group by address (a
-  // std::set<double*>), so no group here holds blocks at unrelated addresses
-  // (the camera parameters are a heap vector per camera): before, the output
-  // folder's name changed the result at 1e-15. The points are one vector in
-  // point3D_id order, the rig poses and the map poses one vector each in
-  // their order; every camera block is a group of its own, in camera order.
-  // Giving Ceres the ordering also spares it the independent-set search over
-  // the whole Hessian graph (a hash set per parameter block), a sizeable part
-  // of each solve's preprocessing with ~10^5 points.
-  std::vector<double*> points;
   for (Eigen::Vector3d& point : refined_points_) {
-    if (problem.HasParameterBlock(point.data())) points.push_back(point.data());
+    solver->AddPoint(point.data());
   }
-  if (!points.empty()) {
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    for (double* block : points) ordering->AddElementToGroup(block, 0);
-    int group = 1;
-    const auto add_group = [&](const std::vector<double*>& blocks) {
-      bool added = false;
-      for (double* block : blocks) {
-        if (problem.HasParameterBlock(block)) {
-          ordering->AddElementToGroup(block, group);
-          added = true;
-        }
-      }
-      group += added ? 1 : 0;
-    };
-    std::vector<double*> poses;
-    for (PoseParams& pose : rig_from_world_) poses.push_back(pose.data());
-    add_group(poses);
-    poses.clear();
-    for (PoseParams& pose : map_cam_from_world_) poses.push_back(pose.data());
-    add_group(poses);
-    add_group({identity_pose_.data()});
-    for (size_t camera = 0; camera < cameras_.size(); ++camera) {
-      add_group({cam_from_rig_[camera].data()});
-      add_group({cameras_[camera].ParamsData()});
-    }
-    for (colmap::Camera& camera : map_cameras_) {
-      add_group({camera.ParamsData()});
-    }
-    solver_options.linear_solver_ordering = ordering;
-    solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-    return solver_options;
-  }
-  std::vector<double*> eliminated;
-  if (options_.refine_rig_poses) {
-    for (PoseParams& pose : rig_from_world_) {
-      if (problem.HasParameterBlock(pose.data())) {
-        eliminated.push_back(pose.data());
-      }
-    }
-  }
-  if (eliminated.empty()) {
-    // Only camera blocks vary: a small sparse normal-equation system.
-    solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    return solver_options;
-  }
-  // The rig poses (one vector: address order = frameset order) in group 0,
-  // then every camera's blocks in groups of their own, in camera order
-  // (Problem::GetParameterBlocks lists by address too).
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (double* block : eliminated) {
-    ordering->AddElementToGroup(block, 0);
-  }
-  int group = 1;
-  for (size_t camera = 0; camera < cameras_.size(); ++camera) {
-    for (double* block :
-         {cam_from_rig_[camera].data(), cameras_[camera].ParamsData()}) {
-      if (problem.HasParameterBlock(block)) {
-        ordering->AddElementToGroup(block, group++);
-      }
-    }
-  }
-  solver_options.linear_solver_ordering = ordering;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  return solver_options;
 }
 
 }  // namespace rig_calibrator

@@ -26,7 +26,7 @@ TEST(FinalBundleAdjusterTest, RecoversExactRigFromPerturbedStart) {
                         &calibration, &summary));
   ExpectExactSolution(rig, "exact", calibration, summary);
   EXPECT_GT(summary.initial_rms_px, 5);
-  EXPECT_FALSE(summary.ceres_report.empty());
+  EXPECT_FALSE(summary.solver_report.empty());
   int num_observations = 0;
   for (size_t i = 0; i < rig.dataset.images.size(); ++i) {
     const ImageResult& result = calibration.images[i];
@@ -270,7 +270,7 @@ TEST(FinalBundleAdjusterTest, DISABLED_LargeInstanceTiming) {
   ASSERT_TRUE(AdjustRig(FinalBundleAdjustmentOptions(), rig.dataset,
                         &calibration, &summary));
   PrintErrors("large", Compare(calibration, rig.truth), summary);
-  std::printf("%s\n", summary.ceres_report.c_str());
+  std::printf("%s\n", summary.solver_report.c_str());
 }
 
 }  // namespace

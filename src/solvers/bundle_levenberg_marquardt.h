@@ -1,0 +1,121 @@
+// Levenberg-Marquardt for bundle-adjustment problems: the final bundle
+// adjustment's own solver (final_bundle_adjuster.h), written for its fixed
+// structure instead of Ceres' general one.
+//
+// Problem. Residual blocks of 2 rows, r_t(x), each a ceres::CostFunction
+// (analytic Jacobians: rig_reprojection_cost.h) over up to three "camera
+// side" parameter blocks (a pose, a cam_from_rig, intrinsics) and at most one
+// point (3 values), with a robust loss rho:
+//
+//   min_x  F(x) = 1/2 sum_t rho(|r_t(x)|^2).
+//
+// Parameter blocks live on manifolds (ceres::Manifold: quaternion x R^3 for
+// poses, a subset manifold for partly held intrinsics); steps are taken in
+// their tangent spaces, x' = Plus(x, delta). Camera-side blocks are put in
+// groups (e.g. a camera's cam_from_rig and intrinsics): a group is one block
+// row of the reduced system, so that an observation touches two of them
+// instead of three.
+//
+// Step. As Ceres' Levenberg-Marquardt: with the robust loss folded into r and
+// J by Triggs' correction (ceres/corrector.h's rule: sqrt(rho') scaling, plus
+// the curvature term when rho'' > 0), the step solves
+//
+//   (J^T J + D / mu) delta = -J^T r,   D = clamp(diag(J^T J), 1e-6, 1e32),
+//
+// mu the trust-region radius. The points are eliminated by their 3 x 3 blocks
+// (Schur complement): with U, V_p, W_p the camera-side, point and mixed
+// blocks of J^T J + D / mu, and b_c, b_p those of J^T r,
+//
+//   (U - sum_p W_p^T V_p^-1 W_p) delta_c = -b_c + sum_p W_p^T V_p^-1 b_p,
+//   delta_p = V_p^-1 (-b_p - W_p delta_c),
+//
+// the reduced system (groups) is factorized by CHOLMOD's supernodal sparse
+// Cholesky (symbolic analysis once per Solve). A step is accepted when the
+// cost decrease is at least 1e-3 of the model's, rho = (F(x) - F(x')) /
+// (1/2 |r|^2 - 1/2 |r + J delta|^2); then mu /= max(1/3, 1 - (2 rho - 1)^3),
+// else mu is divided by a factor that doubles with every rejection in a row.
+// Stops when a step changes F by less than function_tolerance * F, when the
+// step is below parameter_tolerance * (|x| + parameter_tolerance), when the
+// gradient's largest entry is below gradient_tolerance, or after
+// max_num_iterations steps (accepted or not).
+//
+// Threads, deterministically. The residual blocks and the points are cut into
+// a fixed number of chunks, whatever the thread count; each chunk evaluates
+// into its own slots and adds its part of the reduced system, the costs and
+// gradients into its own copy, and the copies are added in chunk order. The
+// result is therefore bit-identical for any thread count, unlike Ceres 2.1,
+// whose threads add in the order they finish.
+#pragma once
+
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rig_calibrator {
+
+struct BundleLevenbergMarquardtOptions {
+  int max_num_iterations = 100;
+  double function_tolerance = 1e-6;
+  double parameter_tolerance = 1e-8;
+  double gradient_tolerance = 1e-10;
+  double initial_trust_region_radius = 1e4;
+  int num_threads = -1;  // -1: all cores; the result does not depend on it
+  bool print_progress = false;  // one line per iteration on stdout
+};
+
+struct BundleLevenbergMarquardtSummary {
+  enum class Termination { kConvergence, kNoConvergence, kFailure };
+  Termination termination = Termination::kFailure;
+  std::string message;
+  int num_successful_steps = 0, num_unsuccessful_steps = 0;
+  double initial_cost = 0, final_cost = 0;  // F
+  int num_residual_blocks = 0, num_points = 0, reduced_system_size = 0;
+  // Wall time of Solve, of which building the structure (batches, the
+  // reduced system's pattern and its symbolic factorization), evaluating
+  // residuals and Jacobians, forming the reduced system and factorizing it
+  // (seconds).
+  double seconds = 0, structure_seconds = 0, evaluation_seconds = 0,
+         schur_seconds = 0, factorization_seconds = 0;
+
+  bool IsSolutionUsable() const { return termination != Termination::kFailure; }
+  // One line: iterations, costs, termination (CONVERGENCE, NO_CONVERGENCE or
+  // FAILURE) and the message.
+  std::string BriefReport() const;
+};
+
+class BundleLevenbergMarquardt {
+ public:
+  explicit BundleLevenbergMarquardt(
+      const BundleLevenbergMarquardtOptions& options);
+  ~BundleLevenbergMarquardt();
+
+  // A camera-side parameter block of `size` values at `values`, refined on
+  // `manifold` (null: Euclidean) as part of group `group` (>= 0; groups are
+  // numbered from 0 without gaps, and a group's blocks are its columns in the
+  // order they are added). Not owned; they outlive Solve.
+  void AddParameterBlock(double* values, int size,
+                         const ceres::Manifold* manifold, int group);
+  // A point (3 values, Euclidean), eliminated in the reduced system.
+  void AddPoint(double* values);
+  // A residual block of 2 rows: `cost` over `parameters` (the pointers its
+  // Evaluate takes, in its order). A pointer that was added as a parameter
+  // block or a point is refined, any other is held constant. `loss` null:
+  // least squares. Neither is owned.
+  void AddResidualBlock(const ceres::CostFunction* cost,
+                        const ceres::LossFunction* loss,
+                        const std::vector<double*>& parameters);
+
+  // Minimizes F from the current values, which it updates (the last accepted
+  // estimate, also when the solve fails midway).
+  void Solve(BundleLevenbergMarquardtSummary* summary);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rig_calibrator

@@ -1,0 +1,381 @@
+#include "src/solvers/bundle_levenberg_marquardt.h"
+
+#include <ceres/ceres.h>
+#include <colmap/base/camera_models.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "src/geometry/rig_reprojection_cost.h"
+
+namespace rig_calibrator {
+namespace {
+
+using Pose = std::array<double, 7>;  // [qw, qx, qy, qz, tx, ty, tz]
+
+// A two-camera rig (camera 0 the reference, identity cam_from_rig; camera 1
+// looking sideways) in 8 framesets along a line, SIMPLE_RADIAL cameras,
+// points in front of both. The first rig pose and 30 points are held: they
+// fix the gauge (frame and scale).
+struct Scene {
+  static constexpr int kNumFramesets = 8;
+  static constexpr int kNumPoints = 400;
+  static constexpr int kNumFixedPoints = 30;
+  std::vector<Pose> rig_from_world;
+  std::array<Pose, 2> cam_from_rig;
+  std::array<std::vector<double>, 2> intrinsics;
+  std::vector<Eigen::Vector3d> points;
+  struct Observation {
+    int frameset, camera, point;
+    Eigen::Vector2d pixel;
+  };
+  std::vector<Observation> observations;
+};
+
+Pose MakePose(const Eigen::Quaterniond& q, const Eigen::Vector3d& t) {
+  return {q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()};
+}
+
+Eigen::Vector3d Transform(const Pose& pose, const Eigen::Vector3d& x) {
+  return Eigen::Quaterniond(pose[0], pose[1], pose[2], pose[3]) * x +
+         Eigen::Vector3d(pose[4], pose[5], pose[6]);
+}
+
+Scene MakeScene(double noise_px, double outlier_ratio, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  std::normal_distribution<double> normal(0, 1);
+  Scene scene;
+  for (int j = 0; j < Scene::kNumFramesets; ++j) {
+    scene.rig_from_world.push_back(
+        MakePose(Eigen::Quaterniond(
+                     Eigen::AngleAxisd(0.05 * j, Eigen::Vector3d::UnitY())),
+                 Eigen::Vector3d(-0.3 * j, 0.02 * j, 0)));
+  }
+  scene.cam_from_rig[0] =
+      MakePose(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  scene.cam_from_rig[1] = MakePose(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitY())),
+      Eigen::Vector3d(0.2, 0.01, -0.05));
+  scene.intrinsics[0] = {500, 320, 240, -0.05};
+  scene.intrinsics[1] = {450, 310, 250, 0.03};
+  for (int p = 0; p < Scene::kNumPoints; ++p) {
+    // In front of camera 0 or 1 of the middle frameset.
+    const Eigen::Vector3d in_cam(3 * uniform(rng), 2 * uniform(rng),
+                                 5 + 2 * uniform(rng));
+    const Pose& rig = scene.rig_from_world[Scene::kNumFramesets / 2];
+    const Pose& cam = scene.cam_from_rig[p % 2];
+    const Eigen::Quaterniond q_rig(rig[0], rig[1], rig[2], rig[3]);
+    const Eigen::Quaterniond q_cam(cam[0], cam[1], cam[2], cam[3]);
+    const Eigen::Vector3d in_rig =
+        q_cam.inverse() * (in_cam - Eigen::Vector3d(cam[4], cam[5], cam[6]));
+    scene.points.push_back(q_rig.inverse() *
+                           (in_rig - Eigen::Vector3d(rig[4], rig[5], rig[6])));
+  }
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int j = 0; j < Scene::kNumFramesets; ++j) {
+    for (int c = 0; c < 2; ++c) {
+      for (int p = 0; p < Scene::kNumPoints; ++p) {
+        const Eigen::Vector3d x =
+            Transform(scene.cam_from_rig[c],
+                      Transform(scene.rig_from_world[j], scene.points[p]));
+        if (x.z() < 1) continue;
+        Eigen::Vector2d pixel;
+        colmap::SimpleRadialCameraModel::WorldToImage(
+            scene.intrinsics[c].data(), x.x() / x.z(), x.y() / x.z(),
+            &pixel.x(), &pixel.y());
+        if (pixel.x() < 0 || pixel.x() > 640 || pixel.y() < 0 ||
+            pixel.y() > 480) {
+          continue;
+        }
+        pixel += noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+        if (unit(rng) < outlier_ratio) {
+          pixel += Eigen::Vector2d(30 * uniform(rng), 30 * uniform(rng));
+        }
+        scene.observations.push_back({j, c, p, pixel});
+      }
+    }
+  }
+  // A point seen once has 3 unknowns for 2 residuals: not observed at all.
+  std::vector<int> count(Scene::kNumPoints, 0);
+  for (const Scene::Observation& observation : scene.observations) {
+    ++count[observation.point];
+  }
+  std::vector<Scene::Observation> kept;
+  for (const Scene::Observation& observation : scene.observations) {
+    if (count[observation.point] >= 2) kept.push_back(observation);
+  }
+  scene.observations = kept;
+  return scene;
+}
+
+// The scene's unknowns moved away from the truth.
+Scene Perturbed(const Scene& truth, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0, 1);
+  Scene start = truth;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    const Eigen::Quaterniond q(
+        start.rig_from_world[j][0], start.rig_from_world[j][1],
+        start.rig_from_world[j][2], start.rig_from_world[j][3]);
+    const Eigen::Quaterniond dq(Eigen::AngleAxisd(
+        0.02,
+        Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized()));
+    const Eigen::Vector3d t =
+        Eigen::Vector3d(start.rig_from_world[j].data() + 4) +
+        0.03 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    start.rig_from_world[j] = MakePose(dq * q, t);
+  }
+  start.cam_from_rig[1][4] += 0.03;
+  start.cam_from_rig[1][6] -= 0.02;
+  start.intrinsics[0][0] *= 1.02;
+  start.intrinsics[0][3] = 0;
+  start.intrinsics[1][0] *= 0.98;
+  start.intrinsics[1][3] = 0;
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    start.points[p] +=
+        0.02 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+  }
+  return start;
+}
+
+// The problem over `scene` (updated in place) for either solver: the first
+// rig pose and camera 0's cam_from_rig held, camera 1's principal point
+// held (subset manifold), the first kNumFixedPoints points fixed.
+struct Problem {
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  std::vector<std::vector<double*>> parameters;
+  ceres::ProductManifold<ceres::QuaternionManifold, ceres::EuclideanManifold<3>>
+      pose_manifold;
+  ceres::SubsetManifold principal_point_held{4, {1, 2}};
+};
+
+void BuildProblem(Scene* scene, Problem* problem) {
+  for (const Scene::Observation& observation : scene->observations) {
+    const bool fixed = observation.point < Scene::kNumFixedPoints;
+    problem->costs.emplace_back(CreateRigReprojectionCost(
+        colmap::SimpleRadialCameraModel::kModelId, observation.pixel,
+        fixed ? &scene->points[observation.point] : nullptr));
+    std::vector<double*> parameters = {
+        scene->rig_from_world[observation.frameset].data(),
+        scene->cam_from_rig[observation.camera].data(),
+        scene->intrinsics[observation.camera].data()};
+    if (!fixed) parameters.push_back(scene->points[observation.point].data());
+    problem->parameters.push_back(parameters);
+  }
+}
+
+void SolveOurs(const ceres::LossFunction* loss, int num_threads, Scene* scene,
+               BundleLevenbergMarquardtSummary* summary) {
+  Problem problem;
+  BuildProblem(scene, &problem);
+  BundleLevenbergMarquardtOptions options;
+  options.parameter_tolerance = 1e-12;
+  options.function_tolerance = 1e-12;
+  options.num_threads = num_threads;
+  BundleLevenbergMarquardt solver(options);
+  int group = 0;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    solver.AddParameterBlock(scene->rig_from_world[j].data(), 7,
+                             &problem.pose_manifold, group++);
+  }
+  solver.AddParameterBlock(scene->intrinsics[0].data(), 4, nullptr, group++);
+  solver.AddParameterBlock(scene->cam_from_rig[1].data(), 7,
+                           &problem.pose_manifold, group);
+  solver.AddParameterBlock(scene->intrinsics[1].data(), 4,
+                           &problem.principal_point_held, group++);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    solver.AddPoint(scene->points[p].data());
+  }
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    solver.AddResidualBlock(problem.costs[k].get(), loss,
+                            problem.parameters[k]);
+  }
+  solver.Solve(summary);
+}
+
+double SolveCeres(ceres::LossFunction* loss, Scene* scene) {
+  Problem problem;
+  BuildProblem(scene, &problem);
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    ceres_problem.AddResidualBlock(problem.costs[k].get(), loss,
+                                   problem.parameters[k]);
+  }
+  ceres_problem.SetParameterBlockConstant(scene->rig_from_world[0].data());
+  ceres_problem.SetParameterBlockConstant(scene->cam_from_rig[0].data());
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    ceres_problem.SetManifold(scene->rig_from_world[j].data(),
+                              &problem.pose_manifold);
+  }
+  ceres_problem.SetManifold(scene->cam_from_rig[1].data(),
+                            &problem.pose_manifold);
+  ceres_problem.SetManifold(scene->intrinsics[1].data(),
+                            &problem.principal_point_held);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.function_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-12;
+  options.max_num_iterations = 200;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &ceres_problem, &summary);
+  EXPECT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
+  return summary.final_cost;
+}
+
+struct Errors {
+  double rotation_rad = 0, translation = 0, point = 0, focal_relative = 0,
+         extra = 0;
+};
+
+Errors Compare(const Scene& a, const Scene& b) {
+  Errors errors;
+  const auto pose_error = [&](const Pose& x, const Pose& y) {
+    const Eigen::Quaterniond qx(x[0], x[1], x[2], x[3]);
+    const Eigen::Quaterniond qy(y[0], y[1], y[2], y[3]);
+    errors.rotation_rad = std::max(errors.rotation_rad, qx.angularDistance(qy));
+    errors.translation = std::max(
+        errors.translation,
+        (Eigen::Vector3d(x.data() + 4) - Eigen::Vector3d(y.data() + 4)).norm());
+  };
+  for (int j = 0; j < Scene::kNumFramesets; ++j) {
+    pose_error(a.rig_from_world[j], b.rig_from_world[j]);
+  }
+  pose_error(a.cam_from_rig[1], b.cam_from_rig[1]);
+  for (int c = 0; c < 2; ++c) {
+    errors.focal_relative =
+        std::max(errors.focal_relative,
+                 std::abs(a.intrinsics[c][0] / b.intrinsics[c][0] - 1));
+    errors.extra = std::max(errors.extra,
+                            std::abs(a.intrinsics[c][3] - b.intrinsics[c][3]));
+  }
+  for (const Scene::Observation& observation : a.observations) {
+    const int p = observation.point;
+    errors.point = std::max(errors.point, (a.points[p] - b.points[p]).norm());
+  }
+  return errors;
+}
+
+TEST(BundleLevenbergMarquardtTest, RecoversExactSceneFromPerturbedStart) {
+  const Scene truth = MakeScene(0, 0, 1);
+  Scene scene = Perturbed(truth, 2);
+  const Errors start = Compare(scene, truth);
+  ASSERT_GT(start.rotation_rad, 0.01);
+  ASSERT_GT(start.focal_relative, 0.015);
+  BundleLevenbergMarquardtSummary summary;
+  SolveOurs(nullptr, -1, &scene, &summary);
+  ASSERT_EQ(summary.termination,
+            BundleLevenbergMarquardtSummary::Termination::kConvergence)
+      << summary.BriefReport();
+  EXPECT_GT(summary.initial_cost, 100);
+  EXPECT_LT(summary.final_cost, 1e-16);
+  EXPECT_EQ(summary.num_points, Scene::kNumPoints - Scene::kNumFixedPoints);
+  // 7 rig poses, camera 0's intrinsics, camera 1's cam_from_rig + 2 free
+  // intrinsics.
+  EXPECT_EQ(summary.reduced_system_size, 7 * 6 + 4 + 6 + 2);
+  const Errors errors = Compare(scene, truth);
+  EXPECT_LT(errors.rotation_rad, 1e-9);
+  EXPECT_LT(errors.translation, 1e-9);
+  EXPECT_LT(errors.point, 1e-8);
+  EXPECT_LT(errors.focal_relative, 1e-10);
+  EXPECT_LT(errors.extra, 1e-10);
+  // Held values stay bit-identical: the first rig pose, camera 0's
+  // cam_from_rig, camera 1's principal point.
+  EXPECT_EQ(scene.rig_from_world[0], truth.rig_from_world[0]);
+  EXPECT_EQ(scene.cam_from_rig[0], truth.cam_from_rig[0]);
+  EXPECT_EQ(scene.intrinsics[1][1], truth.intrinsics[1][1]);
+  EXPECT_EQ(scene.intrinsics[1][2], truth.intrinsics[1][2]);
+}
+
+TEST(BundleLevenbergMarquardtTest, RobustSolveMatchesCeresAndIsAccurate) {
+  const Scene truth = MakeScene(0.5, 0.1, 3);
+  const Scene start = Perturbed(truth, 4);
+  ceres::CauchyLoss loss(1.0);
+  Scene ours = start;
+  BundleLevenbergMarquardtSummary summary;
+  SolveOurs(&loss, 2, &ours, &summary);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
+  Scene ceres = start;
+  const double ceres_cost = SolveCeres(&loss, &ceres);
+  // The same minimum of the same objective.
+  EXPECT_NEAR(summary.final_cost, ceres_cost, 1e-8 * ceres_cost);
+  const Errors between = Compare(ours, ceres);
+  EXPECT_LT(between.rotation_rad, 1e-7);
+  EXPECT_LT(between.translation, 1e-6);
+  EXPECT_LT(between.point, 1e-5);
+  EXPECT_LT(between.focal_relative, 1e-7);
+  // Against the truth, despite 10 % outliers of up to 30 px.
+  const Errors errors = Compare(ours, truth);
+  EXPECT_LT(errors.rotation_rad, 1e-3);
+  EXPECT_LT(errors.translation, 5e-3);
+  EXPECT_LT(errors.focal_relative, 2e-3);
+  EXPECT_LT(errors.extra, 5e-3);
+}
+
+TEST(BundleLevenbergMarquardtTest, ResultDoesNotDependOnThreadCount) {
+  const Scene truth = MakeScene(0.5, 0.1, 5);
+  const Scene start = Perturbed(truth, 6);
+  ceres::CauchyLoss loss(1.0);
+  Scene one = start, two = start, three = start;
+  BundleLevenbergMarquardtSummary summary_one, summary_two, summary_three;
+  SolveOurs(&loss, 1, &one, &summary_one);
+  SolveOurs(&loss, 2, &two, &summary_two);
+  SolveOurs(&loss, 3, &three, &summary_three);
+  ASSERT_TRUE(summary_one.IsSolutionUsable());
+  EXPECT_EQ(summary_one.final_cost, summary_two.final_cost);
+  EXPECT_EQ(summary_one.final_cost, summary_three.final_cost);
+  EXPECT_EQ(summary_one.num_successful_steps, summary_two.num_successful_steps);
+  for (const Scene* other : {&two, &three}) {
+    EXPECT_EQ(one.rig_from_world, other->rig_from_world);
+    EXPECT_EQ(one.cam_from_rig, other->cam_from_rig);
+    EXPECT_EQ(one.intrinsics, other->intrinsics);
+    EXPECT_EQ(one.points, other->points);
+  }
+}
+
+TEST(BundleLevenbergMarquardtTest, UnusableStartFailsAndLeavesValues) {
+  const Scene truth = MakeScene(0, 0, 7);
+  Scene scene = truth;
+  // A refined point behind every camera: the residuals cannot be evaluated.
+  scene.points.back() = Eigen::Vector3d(0, 0, -100);
+  const Scene before = scene;
+  BundleLevenbergMarquardtSummary summary;
+  SolveOurs(nullptr, 2, &scene, &summary);
+  EXPECT_FALSE(summary.IsSolutionUsable());
+  EXPECT_NE(summary.message.find("initial values"), std::string::npos);
+  EXPECT_NE(summary.BriefReport().find("FAILURE"), std::string::npos);
+  EXPECT_EQ(scene.points, before.points);
+  EXPECT_EQ(scene.rig_from_world, before.rig_from_world);
+}
+
+TEST(BundleLevenbergMarquardtTest, StopsAtTheIterationLimit) {
+  const Scene truth = MakeScene(0.5, 0, 8);
+  Scene scene = Perturbed(truth, 9);
+  Problem problem;
+  BuildProblem(&scene, &problem);
+  BundleLevenbergMarquardtOptions options;
+  options.max_num_iterations = 2;
+  options.function_tolerance = 0;
+  BundleLevenbergMarquardt solver(options);
+  solver.AddParameterBlock(scene.intrinsics[0].data(), 4, nullptr, 0);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    solver.AddResidualBlock(problem.costs[k].get(), nullptr,
+                            problem.parameters[k]);
+  }
+  BundleLevenbergMarquardtSummary summary;
+  solver.Solve(&summary);
+  EXPECT_EQ(summary.termination,
+            BundleLevenbergMarquardtSummary::Termination::kNoConvergence);
+  EXPECT_EQ(summary.num_successful_steps + summary.num_unsuccessful_steps, 2);
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+}
+
+}  // namespace
+}  // namespace rig_calibrator
