@@ -30,6 +30,11 @@
 namespace rig_calibrator {
 namespace {
 
+// How the final bundle adjustment solves its steps
+// (src/solvers/bundle_levenberg_marquardt.h).
+constexpr char kOurLinearSolver[] =
+    "Schur complement of the points + CHOLMOD sparse Cholesky";
+
 namespace fs = std::filesystem;
 
 // The last match of `pattern`'s first group in `text`, or "".
@@ -511,8 +516,7 @@ std::string Csv(const std::vector<Comparison>& comparisons) {
           << "," << Number(run->max_rotation_error_deg) << ","
           << Number(run->max_center_error_m) << ",\"" << run->termination
           << "\",\""
-          << (run == &c.ours ? "SPARSE_SCHUR (points eliminated)"
-                             : c.colmap_linear_solver)
+          << (run == &c.ours ? kOurLinearSolver : c.colmap_linear_solver)
           << "\"," << c.data->num_start_inliers << ","
           << c.data->num_single_observations << "," << run->num_behind << ","
           << (run->reported_rms_px >= 0 ? Number(run->reported_rms_px) : "")
@@ -582,7 +586,7 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
         "lacking a reference-camera image.\n\n";
   for (const Comparison& c : comparisons) {
     md << "- " << c.framesets << " x " << c.cameras << ": COLMAP "
-       << c.colmap_linear_solver << ", ours SPARSE_SCHUR (points eliminated); "
+       << c.colmap_linear_solver << ", ours " << kOurLinearSolver << "; "
        << "model_converter " << Fixed(c.colmap_io_seconds, 2) << " s; "
        << c.data->num_framesets << " framesets compared, "
        << c.data->num_dropped_framesets << " dropped; "
