@@ -120,8 +120,13 @@ class RigAdjustment {
   std::vector<double> MaxErrorPerSlot(
       const std::vector<std::pair<int, ObservationError>>& errors) const;
 
-  void AddParameterBlocks(BundleLevenbergMarquardt* solver);
+  // The blocks and residuals of the next solve, over the rig observations
+  // and `map_observations` (MapObservationsInProblem()).
+  void AddParameterBlocks(
+      const std::vector<MapObservationRef>& map_observations,
+      BundleLevenbergMarquardt* solver);
   void AddResidualBlocks(
+      const std::vector<MapObservationRef>& map_observations,
       BundleLevenbergMarquardt* solver,
       std::vector<std::unique_ptr<ceres::CostFunction>>* costs);
 

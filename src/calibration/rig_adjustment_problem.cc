@@ -25,9 +25,13 @@ bool RigAdjustment::Solve(double function_tolerance,
   solver_options.num_threads = options_.num_threads;
   solver_options.print_progress = options_.print_progress;
   BundleLevenbergMarquardt solver(solver_options);
-  AddParameterBlocks(&solver);
+  const std::vector<MapObservationRef> map_observations =
+      MapObservationsInProblem();
+  solver.Reserve(observations_.size() + map_observations.size(),
+                 refined_points_.size());
+  AddParameterBlocks(map_observations, &solver);
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  AddResidualBlocks(&solver, &costs);
+  AddResidualBlocks(map_observations, &solver, &costs);
   VLOG(1) << "Final bundle adjustment: " << costs.size() << " observations";
   solver.Solve(summary);
   VLOG(1) << summary->BriefReport() << "; " << summary->seconds
@@ -45,10 +49,11 @@ bool RigAdjustment::Solve(double function_tolerance,
 }
 
 void RigAdjustment::AddResidualBlocks(
+    const std::vector<MapObservationRef>& map_observations,
     BundleLevenbergMarquardt* solver,
     std::vector<std::unique_ptr<ceres::CostFunction>>* costs) {
   has_fixed_points_ = false;
-  costs->reserve(observations_.size());
+  costs->reserve(observations_.size() + map_observations.size());
   for (const Observation& observation : observations_) {
     const RigImage& image = dataset_.images[observation.image];
     const Correspondence& correspondence = CorrespondenceOf(observation);
@@ -71,7 +76,7 @@ void RigAdjustment::AddResidualBlocks(
           {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
   }
-  for (const MapObservationRef& observation : MapObservationsInProblem()) {
+  for (const MapObservationRef& observation : map_observations) {
     const MapObservation& map_observation = MapObservationOf(observation);
     colmap::Camera& camera =
         map_cameras_[dataset_.map_images[observation.image].camera_index];
@@ -91,7 +96,9 @@ void RigAdjustment::AddResidualBlocks(
 // observation then couples two groups, not three), every refined map
 // camera's intrinsics. Blocks that are not added are held constant. The
 // points are added in point3D_id order.
-void RigAdjustment::AddParameterBlocks(BundleLevenbergMarquardt* solver) {
+void RigAdjustment::AddParameterBlocks(
+    const std::vector<MapObservationRef>& map_observations,
+    BundleLevenbergMarquardt* solver) {
   // Only the blocks that the observations use.
   std::vector<char> frameset_used(rig_from_world_.size(), 0);
   std::vector<char> camera_used(cameras_.size(), 0);
@@ -102,7 +109,7 @@ void RigAdjustment::AddParameterBlocks(BundleLevenbergMarquardt* solver) {
   }
   std::vector<char> map_image_used(map_cam_from_world_.size(), 0);
   std::vector<char> map_camera_used(map_cameras_.size(), 0);
-  for (const MapObservationRef& observation : MapObservationsInProblem()) {
+  for (const MapObservationRef& observation : map_observations) {
     map_image_used[observation.image] = 1;
     map_camera_used[dataset_.map_images[observation.image].camera_index] = 1;
   }

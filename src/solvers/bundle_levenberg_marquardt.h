@@ -99,6 +99,9 @@ class BundleLevenbergMarquardt {
   // order they are added). Not owned; they outlive Solve.
   void AddParameterBlock(double* values, int size,
                          const ceres::Manifold* manifold, int group);
+  // Room for this many residual blocks and points (saves regrowing the
+  // lists at 10^6 residuals).
+  void Reserve(size_t num_residual_blocks, size_t num_points);
   // A point (3 values, Euclidean), eliminated in the reduced system.
   void AddPoint(double* values);
   // A residual block of 2 rows: `cost` over `parameters` (the pointers its
