@@ -314,7 +314,9 @@ void BundleLevenbergMarquardt::Impl::ApplyStep(std::vector<double>* saved) {
 }
 
 bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
-  // Groups: sizes and offsets from their blocks' tangent sizes.
+  // Groups: sizes and offsets from their blocks' tangent sizes (anew, so
+  // that Solve may be called again).
+  groups.clear();
   for (Block& block : blocks) {
     if (block.group < 0) {
       *error = "a negative parameter group";

@@ -355,6 +355,30 @@ TEST(BundleLevenbergMarquardtTest, UnusableStartFailsAndLeavesValues) {
   EXPECT_EQ(scene.rig_from_world, before.rig_from_world);
 }
 
+TEST(BundleLevenbergMarquardtTest, SolvingAgainContinuesFromTheResult) {
+  const Scene truth = MakeScene(0.5, 0, 10);
+  Scene scene = Perturbed(truth, 11);
+  Problem problem;
+  BuildProblem(&scene, &problem);
+  BundleLevenbergMarquardtOptions options;
+  options.max_num_iterations = 3;
+  BundleLevenbergMarquardt solver(options);
+  solver.AddParameterBlock(scene.intrinsics[0].data(), 4, nullptr, 0);
+  solver.AddParameterBlock(scene.cam_from_rig[1].data(), 7,
+                           &problem.pose_manifold, 1);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    solver.AddResidualBlock(problem.costs[k].get(), nullptr,
+                            problem.parameters[k]);
+  }
+  BundleLevenbergMarquardtSummary first, second;
+  solver.Solve(&first);
+  solver.Solve(&second);
+  ASSERT_TRUE(second.IsSolutionUsable()) << second.BriefReport();
+  EXPECT_EQ(second.reduced_system_size, first.reduced_system_size);
+  EXPECT_EQ(second.initial_cost, first.final_cost);
+  EXPECT_LE(second.final_cost, first.final_cost);
+}
+
 TEST(BundleLevenbergMarquardtTest, StopsAtTheIterationLimit) {
   const Scene truth = MakeScene(0.5, 0, 8);
   Scene scene = Perturbed(truth, 9);
