@@ -24,6 +24,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "src/calibration/final_bundle_adjuster.h"
 #include "src/geometry/rigid3d.h"
 #include "src/synthetic/synthetic_rig.h"
 
@@ -37,10 +38,9 @@ struct ColmapRigBaComparisonOptions {
   // The extended colmap executable (empty: `colmap` beside this executable).
   std::string colmap_executable;
   // Both stop when an iteration lowers the cost by less than this share of
-  // it: final_bundle_adjuster.cc's kFunctionTolerance (AdjustRig's own,
-  // not an option of it); given to COLMAP as
+  // it: AdjustRig's own, not an option of it; given to COLMAP as
   // --BundleAdjustment.function_tolerance.
-  double function_tolerance = 1e-5;
+  double function_tolerance = kFinalBundleAdjustmentFunctionTolerance;
   int max_num_iterations = 100;
   // AdjustRig's Cauchy scale: rho(s) = b^2 log(1 + s / b^2) weighs a residual
   // r by 1 / (1 + r^2 / b^2), so with b = 100 px and the inliers within the

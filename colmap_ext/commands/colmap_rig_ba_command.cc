@@ -35,7 +35,7 @@ int RunColmapRigBaBenchmark(int argc, char** argv) {
             "the extended colmap (empty: colmap beside this executable)");
   AddOption(&description, "function_tolerance", &options.function_tolerance,
             "both solvers' function tolerance (AdjustRig's is fixed at "
-            "1e-5: keep them equal)");
+            "1e-4: keep them equal)");
   AddOption(&description, "max_num_iterations", &options.max_num_iterations,
             "both solvers' iteration limit");
   AddOption(&description, "loss_scale_px", &options.loss_scale_px,

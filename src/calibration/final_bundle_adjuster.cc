@@ -48,12 +48,6 @@ bool CheckInput(const FinalBundleAdjustmentOptions& options,
   return true;
 }
 
-// Stop a solve when an iteration lowers the cost by less than this share of
-// it (Ceres' default 1e-6). With refined map points the last iterations only
-// polish tens of thousands of points: 500 framesets x 10 cameras, final BA
-// 58 s -> 40 s, 200 x 10: 24 -> 12 s, with the same errors against the truth
-// (and the same on the rendered demo); exact data still converge to 1e-8.
-constexpr double kFunctionTolerance = 1e-5;
 // A solve whose only use is to tell the outliers from the inliers stops
 // earlier: the residuals that decide the pruning (thresholds of 2 px or
 // more) no longer move once the cost changes by 1e-3 per iteration, and the
@@ -66,8 +60,8 @@ constexpr double kPruningFunctionTolerance = 1e-3;
 // The first solve, then prune-and-resolve rounds until a round prunes
 // nothing or num_pruning_rounds are done. A solve followed by a pruning
 // round stops at kPruningFunctionTolerance; if that round prunes nothing,
-// one more solve converges to kFunctionTolerance. Fills the counts of
-// `result`.
+// one more solve converges to kFinalBundleAdjustmentFunctionTolerance. Fills
+// the counts of `result`.
 bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
                       RigAdjustment* adjustment,
                       FinalBundleAdjustmentSummary* result) {
@@ -75,8 +69,9 @@ bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
   bool nothing_pruned = false;
   for (int round = 0;; ++round) {
     const bool last = round >= options.num_pruning_rounds;
-    if (!adjustment->Solve(last || nothing_pruned ? kFunctionTolerance
-                                                  : kPruningFunctionTolerance,
+    if (!adjustment->Solve(last || nothing_pruned
+                               ? kFinalBundleAdjustmentFunctionTolerance
+                               : kPruningFunctionTolerance,
                            &solver_summary)) {
       return false;
     }

@@ -42,7 +42,9 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
     const std::vector<char>& mask = calibration.images[i].inlier_mask;
     for (size_t k = 0; k < mask.size(); ++k) {
       if (mask[k]) {
-        observations_.push_back({static_cast<int>(i), static_cast<int>(k)});
+        observations_.emplace_back();
+        observations_.back().image = static_cast<int>(i);
+        observations_.back().correspondence = static_cast<int>(k);
       }
     }
   }
@@ -203,6 +205,8 @@ void RigAdjustment::SelectRefinedPoints() {
   points_selected_ = true;
   // Per point: observations by rig images, then by map images.
   std::unordered_map<int64_t, std::pair<int, int>> num_observations;
+  // Fewer points than observations: no rehash while counting.
+  num_observations.reserve(observations_.size());
   for (const Observation& observation : observations_) {
     const Correspondence& correspondence = CorrespondenceOf(observation);
     if (correspondence.point3D_id >= 0) {

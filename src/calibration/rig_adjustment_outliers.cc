@@ -46,7 +46,7 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
   kept.reserve(num_rig);
   for (size_t k = 0; k < num_rig; ++k) {
     if (fits(errors[k]) && errors[k].second.depth <= max_depth) {
-      kept.push_back(observations_[k]);
+      kept.push_back(std::move(observations_[k]));
     }
   }
   size_t num_removed = num_rig - kept.size();

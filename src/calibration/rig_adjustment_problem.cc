@@ -30,9 +30,10 @@ bool RigAdjustment::Solve(double function_tolerance,
   solver.Reserve(observations_.size() + map_observations.size(),
                  refined_points_.size());
   AddParameterBlocks(map_observations, &solver);
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  AddResidualBlocks(map_observations, &solver, &costs);
-  VLOG(1) << "Final bundle adjustment: " << costs.size() << " observations";
+  std::vector<std::unique_ptr<ceres::CostFunction>> map_costs;
+  AddResidualBlocks(map_observations, &solver, &map_costs);
+  VLOG(1) << "Final bundle adjustment: "
+          << observations_.size() + map_costs.size() << " observations";
   solver.Solve(summary);
   VLOG(1) << summary->BriefReport() << "; " << summary->seconds
           << " s: structure " << summary->structure_seconds << " s, evaluation "
@@ -51,39 +52,43 @@ bool RigAdjustment::Solve(double function_tolerance,
 void RigAdjustment::AddResidualBlocks(
     const std::vector<MapObservationRef>& map_observations,
     BundleLevenbergMarquardt* solver,
-    std::vector<std::unique_ptr<ceres::CostFunction>>* costs) {
+    std::vector<std::unique_ptr<ceres::CostFunction>>* map_costs) {
   has_fixed_points_ = false;
-  costs->reserve(observations_.size() + map_observations.size());
-  for (const Observation& observation : observations_) {
+  for (Observation& observation : observations_) {
     const RigImage& image = dataset_.images[observation.image];
     const Correspondence& correspondence = CorrespondenceOf(observation);
     colmap::Camera& camera = cameras_[image.camera_index];
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
-    if (IsPointRefined(correspondence)) {
-      costs->emplace_back(CreateRigReprojectionCost(
-          camera.ModelId(), correspondence.point2D, nullptr));
+    const bool refined = IsPointRefined(correspondence);
+    if (observation.cost == nullptr ||
+        observation.cost_has_refined_point != refined) {
+      observation.cost.reset(CreateRigReprojectionCost(
+          camera.ModelId(), correspondence.point2D,
+          refined ? nullptr : &correspondence.point3D));
+      observation.cost_has_refined_point = refined;
+    }
+    if (refined) {
       solver->AddResidualBlock(
-          costs->back().get(), loss_.get(),
+          observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData(),
            RefinedPoint(correspondence.point3D_id)->data()});
     } else {
       has_fixed_points_ = true;
-      costs->emplace_back(CreateRigReprojectionCost(
-          camera.ModelId(), correspondence.point2D, &correspondence.point3D));
       solver->AddResidualBlock(
-          costs->back().get(), loss_.get(),
+          observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
   }
+  map_costs->reserve(map_observations.size());
   for (const MapObservationRef& observation : map_observations) {
     const MapObservation& map_observation = MapObservationOf(observation);
     colmap::Camera& camera =
         map_cameras_[dataset_.map_images[observation.image].camera_index];
-    costs->emplace_back(CreateRigReprojectionCost(
+    map_costs->emplace_back(CreateRigReprojectionCost(
         camera.ModelId(), map_observation.point2D, nullptr));
     solver->AddResidualBlock(
-        costs->back().get(), loss_.get(),
+        map_costs->back().get(), loss_.get(),
         {map_cam_from_world_[observation.image].data(), identity_pose_.data(),
          camera.ParamsData(),
          RefinedPoint(map_observation.point3D_id)->data()});

@@ -199,5 +199,48 @@ TEST(FinalBundleAdjusterTest, FixedPointsHoldTheGauge) {
   EXPECT_LT(errors.center, 1e-7);
 }
 
+// Points seen twice, one of the two observations moved 80 px off: the first
+// solve refines them, its pruning leaves them one observation, and the next
+// solves hold them at their map position (a point seen once has 3 unknowns
+// for 2 residuals), so their observations' costs change from a refined to a
+// fixed point between the solves. The result is the truth.
+TEST(FinalBundleAdjusterTest, PointsLeftWithOneObservationAreHeldFixed) {
+  MapPointScene scene = MakeMapPointScene(/*fixed_every=*/0);
+  std::unordered_map<int64_t, int> num_observations;
+  for (const RigImage& image : scene.dataset.images) {
+    for (const Correspondence& correspondence : image.correspondences) {
+      ++num_observations[correspondence.point3D_id];
+    }
+  }
+  std::unordered_map<int64_t, bool> tampered;
+  for (RigImage& image : scene.dataset.images) {
+    for (Correspondence& correspondence : image.correspondences) {
+      const int64_t id = correspondence.point3D_id;
+      if (num_observations[id] == 2 && tampered.size() < 40 &&
+          tampered.count(id) == 0) {
+        correspondence.point2D += Eigen::Vector2d(80, -60);
+        tampered[id] = true;
+      }
+    }
+  }
+  ASSERT_EQ(tampered.size(), 40);
+  RigCalibration calibration = scene.start;
+  FinalBundleAdjustmentSummary summary;
+  ASSERT_TRUE(AdjustRig(RefinePoints(), scene.dataset, &calibration, &summary));
+  // Each tampered point loses one observation or, when the split of the
+  // first solve put both over the threshold, both.
+  EXPECT_GE(summary.num_outliers, 40);
+  EXPECT_LE(summary.num_outliers, 80);
+  EXPECT_LT(summary.final_rms_px, 1e-6);
+  for (const auto& [point3D_id, unused] : tampered) {
+    EXPECT_EQ(calibration.refined_points3D.count(point3D_id), 0) << point3D_id;
+  }
+  EXPECT_EQ(calibration.refined_points3D.size() + tampered.size(),
+            scene.truth_points.size());
+  const CalibrationErrors errors = Compare(calibration, scene.rig.truth);
+  EXPECT_LT(errors.rotation_deg, 1e-6);
+  EXPECT_LT(errors.center, 1e-7);
+}
+
 }  // namespace
 }  // namespace rig_calibrator
