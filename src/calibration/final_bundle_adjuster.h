@@ -31,8 +31,8 @@ namespace rig_calibrator {
 // this share of it (Ceres' default 1e-6). With refined map points the last
 // iterations only polish tens of thousands of points along the Cauchy loss'
 // flat tail: 500 framesets x 10 cameras, 1e-5 -> 1e-4 ends the last solve after
-// 2 iterations instead of 7 (the final BA 13 -> 8 iterations, 18.3 -> 15.5 s)
-// with the same errors against the truth (0.0185 -> 0.0183 deg, 0.50 mm);
+// 2 iterations instead of 7 (the final BA 13 -> 8 iterations) with the same
+// errors against the truth (0.0185 -> 0.0183 deg, 0.50 mm);
 // exact data still converge to 1e-8 (each step there lowers the cost by
 // most of it).
 inline constexpr double kFinalBundleAdjustmentFunctionTolerance = 1e-4;
