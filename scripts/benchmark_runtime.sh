@@ -55,7 +55,7 @@ results="$(cd "$results" && pwd)"
 options=("$@")
 if [[ "${BENCHMARK_QUICK:-0}" == 1 && $# -eq 0 ]]; then
   options=(--framesets 10,20 --cameras 5 --map_images 30 --rig_features 1000
-           --rig_images 4 --retrieval_images 1)
+           --rig_images 4 --retrieval_images 1 --repeats 2)
   RUNTIME_BASELINE="${RUNTIME_BASELINE:-$rig_calibrator}"
   RUNTIME_COLMAP_RIG_BA="${RUNTIME_COLMAP_RIG_BA:-1}"
   RUNTIME_COLMAP_RIG_BA_OPTIONS="${RUNTIME_COLMAP_RIG_BA_OPTIONS:---quick 1}"

@@ -1,5 +1,7 @@
 #include "colmap_ext/benchmarks/runtime_benchmark.h"
 
+#include <colmap/util/math.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -135,6 +137,43 @@ std::set<int> CameraCounts(const std::vector<CalibrationRuntime>& runs) {
 }
 
 }  // namespace
+
+CalibrationRuntime MedianCalibrationRuntime(
+    const std::vector<CalibrationRuntime>& runs) {
+  if (runs.empty()) return CalibrationRuntime();
+  for (const CalibrationRuntime& run : runs) {
+    if (!run.success) return run;
+  }
+  CalibrationRuntime median = runs.front();
+  const auto median_of = [&](const auto& value_of) {
+    std::vector<double> values;
+    for (const CalibrationRuntime& run : runs) values.push_back(value_of(run));
+    return colmap::Median(values);
+  };
+  median.seconds = median_of([](const auto& run) { return run.seconds; });
+  median.cpu_seconds =
+      median_of([](const auto& run) { return run.cpu_seconds; });
+  median.generation_seconds =
+      median_of([](const auto& run) { return run.generation_seconds; });
+  for (const CalibrationRuntime& run : runs) {
+    median.peak_memory_mb = std::max(median.peak_memory_mb, run.peak_memory_mb);
+  }
+  // Stages by name: every run of one build has the same stages.
+  for (StageRuntime& stage : median.stages) {
+    const auto stage_of = [&](const CalibrationRuntime& run) {
+      for (const StageRuntime& other : run.stages) {
+        if (other.stage == stage.stage) return other;
+      }
+      return StageRuntime();
+    };
+    stage.seconds = median_of(
+        [&](const CalibrationRuntime& run) { return stage_of(run).seconds; });
+    stage.cpu_seconds = median_of([&](const CalibrationRuntime& run) {
+      return stage_of(run).cpu_seconds;
+    });
+  }
+  return median;
+}
 
 std::string SerializeCalibrationRuntime(const CalibrationRuntime& runtime) {
   std::ostringstream text;

@@ -79,6 +79,14 @@ std::string SerializeLocalizationRuntime(const LocalizationRuntime& runtime);
 bool ParseLocalizationRuntime(const std::string& text,
                               LocalizationRuntime* runtime, std::string* error);
 
+// One run standing for repeated runs of the same configuration and build:
+// every stage's wall and CPU seconds and the totals are the medians over the
+// runs (the mean of the middle two for an even count), the peak memory the
+// largest; the rest (counts, iterations, accuracy: deterministic) is the
+// first run's. A failed run stands for all.
+CalibrationRuntime MedianCalibrationRuntime(
+    const std::vector<CalibrationRuntime>& runs);
+
 // CSV with a header row: one row per run; calibration runs have a wall and a
 // CPU column per stage (stages in order of first appearance over all runs;
 // empty cells for stages a run did not have).

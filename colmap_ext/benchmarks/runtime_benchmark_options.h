@@ -51,6 +51,10 @@ struct RuntimeBenchmarkOptions {
   // data, and runtime.md gets a before/after table. It gets this run's
   // options but this one, so it must know them all.
   std::string baseline_executable;
+  // Runs per calibration configuration (and build), alternating before and
+  // after; each stage's time is the median over them (a shared machine's
+  // speed drifts by 10-30 % between runs).
+  int repeats = 1;
   bool calibration = true;
   bool localization = true;
   int map_images = 300;

@@ -128,20 +128,33 @@ ChildOutcome RunChild(const std::vector<std::string>& base_arguments,
   return RunChildProcess(arguments, request.result_path, executable);
 }
 
-// The parent's arguments without --baseline_executable, for the baseline's
-// children (an older build does not know the option).
+// The parent's arguments without the parent-only options
+// (--baseline_executable, --repeats) and their values, for the children: an
+// older build, the baseline, does not know them.
+std::vector<std::string> ChildArguments(
+    const std::vector<std::string>& base_arguments) {
+  std::vector<std::string> arguments = {base_arguments.front()};
+  for (size_t i = 1; i < base_arguments.size(); ++i) {
+    const std::string& argument = base_arguments[i];
+    bool parent_only = false;
+    for (const std::string option : {"--baseline_executable", "--repeats"}) {
+      if (argument == option) {
+        ++i;  // and its value
+        parent_only = true;
+      } else if (argument.rfind(option + "=", 0) == 0) {
+        parent_only = true;
+      }
+    }
+    if (!parent_only) arguments.push_back(argument);
+  }
+  return arguments;
+}
+
 std::vector<std::string> BaselineArguments(
     const std::vector<std::string>& base_arguments,
     const std::string& baseline_executable) {
-  std::vector<std::string> arguments = {baseline_executable};
-  for (size_t i = 1; i < base_arguments.size(); ++i) {
-    const std::string& argument = base_arguments[i];
-    if (argument == "--baseline_executable") {
-      ++i;  // and its value
-    } else if (argument.rfind("--baseline_executable=", 0) != 0) {
-      arguments.push_back(argument);
-    }
-  }
+  std::vector<std::string> arguments = ChildArguments(base_arguments);
+  arguments.front() = baseline_executable;
   return arguments;
 }
 
@@ -198,22 +211,36 @@ std::vector<CalibrationRuntime> RunCalibrations(
       request.result_path = work_dir + "/calibration_" +
                             std::to_string(num_framesets) + "x" +
                             std::to_string(num_cameras) + ".txt";
-      if (with_baseline) {
-        std::cout << "  before (" << options.baseline_executable
-                  << "):" << std::endl;
-        const CalibrationRuntime before = MeasureCalibrationRun(
-            BaselineArguments(base_arguments, options.baseline_executable),
-            request, options.baseline_executable);
-        *all_ok = *all_ok && before.success;
-        PrintCalibrationRun(before);
-        before_runs->push_back(before);
-        std::cout << "  after (this build):" << std::endl;
+      std::vector<CalibrationRuntime> before_repeats, after_repeats;
+      for (int repeat = 0; repeat < options.repeats; ++repeat) {
+        if (options.repeats > 1) {
+          std::cout << "  run " << repeat + 1 << " of " << options.repeats
+                    << ":" << std::endl;
+        }
+        if (with_baseline) {
+          std::cout << "  before (" << options.baseline_executable
+                    << "):" << std::endl;
+          before_repeats.push_back(MeasureCalibrationRun(
+              BaselineArguments(base_arguments, options.baseline_executable),
+              request, options.baseline_executable));
+          PrintCalibrationRun(before_repeats.back());
+          std::cout << "  after (this build):" << std::endl;
+        }
+        after_repeats.push_back(MeasureCalibrationRun(
+            ChildArguments(base_arguments), request, "/proc/self/exe"));
+        PrintCalibrationRun(after_repeats.back());
       }
-      const CalibrationRuntime runtime =
-          MeasureCalibrationRun(base_arguments, request, "/proc/self/exe");
-      *all_ok = *all_ok && runtime.success;
-      PrintCalibrationRun(runtime);
-      runs.push_back(runtime);
+      if (with_baseline) {
+        before_runs->push_back(MedianCalibrationRuntime(before_repeats));
+        *all_ok = *all_ok && before_runs->back().success;
+      }
+      runs.push_back(MedianCalibrationRuntime(after_repeats));
+      *all_ok = *all_ok && runs.back().success;
+      if (options.repeats > 1) {
+        std::cout << "  median of " << options.repeats << " runs:" << std::endl;
+        if (with_baseline) PrintCalibrationRun(before_runs->back());
+        PrintCalibrationRun(runs.back());
+      }
     }
   }
   return runs;
@@ -299,7 +326,12 @@ std::string RuntimeMarkdown(
        << 100 * options.data.outlier_ratio << " % wrong matches, "
        << 100 * options.data.missing_image_ratio
        << " % missing images. Peak memory is that of the process that made "
-          "the synthetic rig and calibrated it.\n\n"
+          "the synthetic rig and calibrated it"
+       << (options.repeats > 1
+               ? " (the largest of " + std::to_string(options.repeats) +
+                     " runs; the times are their medians)"
+               : std::string())
+       << ".\n\n"
        << CalibrationRuntimeMarkdown(calibration_runs) << "\n"
        << "![time vs framesets](runtime_calibration.svg)\n\n";
   }
@@ -307,7 +339,13 @@ std::string RuntimeMarkdown(
     md << "## Before / after\n\n"
        << "Each configuration ran with `" << options.baseline_executable
        << "` (before) and then with this build (after), on the same data, "
-          "one after the other in this run. Ratios > 1: the after build is faster.\n\n"
+          "one after the other in this run"
+       << (options.repeats > 1
+               ? ", " + std::to_string(options.repeats) +
+                     " times alternating; every time is the median over "
+                     "those runs"
+               : std::string())
+       << ". Ratios > 1: the after build is faster.\n\n"
        << CalibrationBeforeAfterMarkdown(before_runs, calibration_runs);
   }
   if (!localization_runs.empty()) {
@@ -368,6 +406,11 @@ int RunRuntimeBenchmarkParent(const RuntimeBenchmarkOptions& options,
   RunLists lists;
   std::string error;
   if (!MakeRunLists(options, &lists, &error)) return PrintError(error);
+  if (options.repeats < 1) {
+    return PrintError("--repeats " + std::to_string(options.repeats) +
+                      " must be at least 1 (runs per calibration "
+                      "configuration)");
+  }
   if (!options.baseline_executable.empty() &&
       access(options.baseline_executable.c_str(), X_OK) != 0) {
     return PrintError("--baseline_executable " + options.baseline_executable +

@@ -53,6 +53,9 @@ void AddCalibrationRunOptions(po::options_description* description,
   AddOption(description, "baseline_executable", &o->baseline_executable,
             "another rig_calibrator build: each calibration run is also made "
             "with it, first, for a before/after table");
+  AddOption(description, "repeats", &o->repeats,
+            "runs per calibration configuration and build, before and after "
+            "alternating; the tables give each stage's median");
   AddOption(description, "calibration", &o->calibration,
             "measure the calibration core");
   AddOption(description, "localization", &o->localization,

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "src/estimators/radial_intrinsics_estimator.h"
+#include "src/geometry/full_reprojection_cost.h"
 
 namespace rig_calibrator {
 namespace {
@@ -63,45 +64,6 @@ size_t MinNumPoints(const Initialization& init,
                     const std::optional<double>& known_focal) {
   return init.num_radial_terms + (known_focal ? 2 : 3);
 }
-
-// Full reprojection residual of one correspondence:
-//   WorldToImage(params, a / (c + tz), b / (c + tz)) - observed pixel,
-// with COLMAP's templated camera model. Points on or behind the camera plane
-// (c + tz <= 0) cannot be projected: the evaluation fails, so the LM rejects
-// steps that would move an inlier behind the camera.
-template <typename CameraModel>
-class FullReprojectionCost {
- public:
-  FullReprojectionCost(const Eigen::Vector2d& point2D,
-                       const Eigen::Vector3d& point_cam)
-      : point2D_(point2D), point_cam_(point_cam) {}
-
-  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D,
-                                     const Eigen::Vector3d& point_cam) {
-    return new ceres::AutoDiffCostFunction<FullReprojectionCost, 2, 1,
-                                           CameraModel::kNumParams>(
-        new FullReprojectionCost(point2D, point_cam));
-  }
-
-  template <typename T>
-  bool operator()(const T* const tz, const T* const params,
-                  T* residuals) const {
-    const T depth = T(point_cam_.z()) + tz[0];
-    if (!(depth > T(0))) {
-      return false;
-    }
-    T x, y;
-    CameraModel::WorldToImage(params, T(point_cam_.x()) / depth,
-                              T(point_cam_.y()) / depth, &x, &y);
-    residuals[0] = x - T(point2D_.x());
-    residuals[1] = y - T(point2D_.y());
-    return true;
-  }
-
- private:
-  const Eigen::Vector2d point2D_;
-  const Eigen::Vector3d point_cam_;
-};
 
 // Entries of C = (J^T J)^-1 (variances at 1 px noise); see
 // CameraUpgradeResult.
@@ -287,7 +249,7 @@ void BuildRefinementProblem(const CameraUpgradeOptions& options,
   for (size_t i = 0; i < points2D.size(); ++i) {
     if (inlier_mask[i]) {
       blocks->push_back(problem->AddResidualBlock(
-          FullReprojectionCost<CameraModel>::Create(points2D[i], points_cam[i]),
+          new FullReprojectionCost<CameraModel>(points2D[i], points_cam[i]),
           loss, tz, params->data()));
     }
   }

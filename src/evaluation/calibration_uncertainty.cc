@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
 
 #include "src/calibration/final_bundle_adjuster.h"
@@ -154,6 +155,18 @@ class BlockMatrix {
     it->second += value;
   }
 
+  // Adds every block of `other` (over the same blocks).
+  void AddAll(const BlockMatrix& other) {
+    for (const auto& [key, value] : other.entries_) {
+      auto it = entries_.find(key);
+      if (it == entries_.end()) {
+        entries_.emplace(key, value);
+      } else {
+        it->second += value;
+      }
+    }
+  }
+
   // The stored block (b1 <= b2), or null.
   const Eigen::MatrixXd* Get(int b1, int b2) const {
     const auto it =
@@ -253,7 +266,11 @@ class UncertaintyProblem {
   int AddBlock(int dim, std::vector<int>* slot, int index);
   void AssignBlocks();
   bool Accumulate();
-  void EliminatePoints();
+  struct AccumulationChunk;
+  void AccumulateObservation(const Observation& observation, PointTerms* point,
+                             AccumulationChunk* chunk) const;
+  void EliminatePoint(PointTerms* point, AccumulationChunk* chunk) const;
+  int NumThreads() const;
   void AddGaugePriors();
   bool Marginalize(CalibrationUncertainty* result);
   void AnchorScale();
@@ -507,96 +524,188 @@ Eigen::Vector3d Transform(const double* rig_pose, const double* cam_pose,
   return apply(cam_pose, apply(rig_pose, point));
 }
 
-// J^T J of every observation into the reduced blocks and the points' terms,
-// and the residual statistics of the scale (see the header).
-bool UncertaintyProblem::Accumulate() {
-  reduced_ = std::make_unique<BlockMatrix>(blocks_);
-  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
+// What one chunk of the observations adds to the reduced system and the
+// residual statistics (Accumulate). Aligned to a cache line, so that two
+// threads' chunks never share one.
+struct alignas(64) UncertaintyProblem::AccumulationChunk {
+  std::unique_ptr<BlockMatrix> reduced;
+  double sum_squared = 0, sum_meat = 0, sum_bread = 0;
+  int64_t num_used = 0;
+  int64_t num_point_parameters = 0;            // ranks of the eliminated points
+  std::vector<std::vector<double>> distances;  // per rig camera
+  std::vector<double> j_intrinsics;            // scratch
+  std::vector<std::pair<int, Eigen::MatrixXd>> entries;
+};
+
+int UncertaintyProblem::NumThreads() const {
+  return options_.num_threads > 0
+             ? options_.num_threads
+             : std::max(1,
+                        static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+// J^T J of one observation into the chunk's reduced blocks and the terms of
+// its refined point (`point`, null for a fixed one), and its residual
+// statistics (see the header).
+void UncertaintyProblem::AccumulateObservation(const Observation& observation,
+                                               PointTerms* point,
+                                               AccumulationChunk* chunk) const {
+  const ceres::CostFunction* cost = costs_.at(observation.model_id).get();
+  const int num_params = cost->parameter_block_sizes()[2];
   RowMajor2x7 j_rig, j_cam;
   Eigen::Matrix<double, 2, 3, Eigen::RowMajor> j_point;
-  std::vector<double> j_intrinsics;
-  std::vector<std::pair<int, Eigen::MatrixXd>> entries;
-  int64_t num_used = 0;
+  chunk->j_intrinsics.resize(2 * num_params);
+  const double* parameters[4] = {observation.rig_pose, observation.cam_pose,
+                                 observation.params, observation.point.data()};
+  double* jacobians[4] = {j_rig.data(), j_cam.data(),
+                          chunk->j_intrinsics.data(), j_point.data()};
+  double residual[2];
+  // A point behind its camera is not an inlier of the adjustment.
+  if (!cost->Evaluate(parameters, residual, jacobians)) return;
+  ++chunk->num_used;
+  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
+  const double s = std::pow(residual[0] - observation.observed.x(), 2) +
+                   std::pow(residual[1] - observation.observed.y(), 2);
+  const double u = s / loss_b;
+  chunk->sum_squared += s;
+  chunk->sum_meat += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
+  chunk->sum_bread += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
+  if (observation.rig_camera >= 0) {
+    chunk->distances[observation.rig_camera].push_back(
+        Transform(observation.rig_pose, observation.cam_pose, observation.point)
+            .norm());
+  }
+  std::vector<std::pair<int, Eigen::MatrixXd>>& entries = chunk->entries;
+  entries.clear();
+  if (observation.rig_block >= 0) {
+    entries.emplace_back(observation.rig_block,
+                         PoseTangentJacobian(j_rig, observation.rig_pose));
+  }
+  if (observation.cam_block >= 0) {
+    entries.emplace_back(observation.cam_block,
+                         PoseTangentJacobian(j_cam, observation.cam_pose));
+  }
+  if (observation.intrinsics_block >= 0) {
+    const std::vector<int>& free = *observation.free_intrinsics;
+    Eigen::MatrixXd jacobian(2, free.size());
+    for (size_t k = 0; k < free.size(); ++k) {
+      jacobian(0, k) = chunk->j_intrinsics[free[k]];
+      jacobian(1, k) = chunk->j_intrinsics[num_params + free[k]];
+    }
+    entries.emplace_back(observation.intrinsics_block, jacobian);
+  }
+  for (size_t i = 0; i < entries.size(); ++i) {
+    for (size_t j = i; j < entries.size(); ++j) {
+      chunk->reduced->Add(entries[i].first, entries[j].first,
+                          entries[i].second.transpose() * entries[j].second);
+    }
+  }
+  if (point != nullptr) {
+    point->information += j_point.transpose() * j_point;
+    for (const auto& [block, jacobian] : entries) {
+      point->Cross(block, blocks_[block].dim) += j_point.transpose() * jacobian;
+    }
+  }
+}
+
+// The Schur complement of one point: R -= W^T H_pp^+ W. A point direction
+// without information (e.g. along the ray of a point seen once) has none in
+// W either, so the pseudo-inverse is exact.
+void UncertaintyProblem::EliminatePoint(PointTerms* point,
+                                        AccumulationChunk* chunk) const {
+  int rank = 0;
+  point->pseudo_inverse = PointPseudoInverse(point->information, &rank);
+  chunk->num_point_parameters += rank;
+  for (size_t i = 0; i < point->cross.size(); ++i) {
+    const Eigen::MatrixXd left =
+        point->cross[i].second.transpose() * point->pseudo_inverse;
+    for (size_t j = i; j < point->cross.size(); ++j) {
+      chunk->reduced->Add(point->cross[i].first, point->cross[j].first,
+                          -left * point->cross[j].second);
+    }
+  }
+}
+
+// The reduced system with the points eliminated, and the residual
+// statistics. The observations are taken point by point, in kNumChunks
+// chunks of whole points (the fixed points' observations last), on all
+// threads: a point is eliminated by its chunk as soon as its observations
+// are in, and the chunks' sums are added in chunk order, so the result does
+// not depend on the thread count.
+bool UncertaintyProblem::Accumulate() {
+  constexpr size_t kNumChunks = 8;
+  // The cost functions first: the threads only read the cache.
   for (const Observation& observation : observations_) {
-    ceres::CostFunction* cost = CostFor(observation.model_id);
-    if (cost == nullptr) return false;
-    const int num_params = cost->parameter_block_sizes()[2];
-    j_intrinsics.resize(2 * num_params);
-    const double* parameters[4] = {observation.rig_pose, observation.cam_pose,
-                                   observation.params,
-                                   observation.point.data()};
-    double* jacobians[4] = {j_rig.data(), j_cam.data(), j_intrinsics.data(),
-                            j_point.data()};
-    double residual[2];
-    // A point behind its camera is not an inlier of the adjustment.
-    if (!cost->Evaluate(parameters, residual, jacobians)) continue;
-    ++num_used;
-    const double s = std::pow(residual[0] - observation.observed.x(), 2) +
-                     std::pow(residual[1] - observation.observed.y(), 2);
-    const double u = s / loss_b;
-    sum_squared_ += s;
-    sum_meat_ += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
-    sum_bread_ += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
-    if (observation.rig_camera >= 0) {
-      distances_[observation.rig_camera].push_back(
-          Transform(observation.rig_pose, observation.cam_pose,
-                    observation.point)
-              .norm());
+    if (CostFor(observation.model_id) == nullptr) return false;
+  }
+  // Observations by point (a stable counting sort), fixed points last.
+  const int num_points = static_cast<int>(points_.size());
+  std::vector<size_t> point_begin(num_points + 2, 0);
+  for (const Observation& observation : observations_) {
+    ++point_begin[(observation.point_index < 0 ? num_points
+                                               : observation.point_index) +
+                  1];
+  }
+  for (int p = 0; p <= num_points; ++p) point_begin[p + 1] += point_begin[p];
+  std::vector<size_t> order(observations_.size());
+  std::vector<size_t> next(point_begin.begin(), point_begin.end() - 1);
+  for (size_t o = 0; o < observations_.size(); ++o) {
+    const int p = observations_[o].point_index;
+    order[next[p < 0 ? num_points : p]++] = o;
+  }
+  // Chunks [first, end) of `order`: whole points, about equal sizes.
+  const size_t target =
+      std::max<size_t>(1, (order.size() + kNumChunks - 1) / kNumChunks);
+  std::vector<std::pair<size_t, size_t>> ranges;
+  size_t first = 0;
+  for (int p = 0; p < num_points; ++p) {
+    if (point_begin[p + 1] - first >= target) {
+      ranges.emplace_back(first, point_begin[p + 1]);
+      first = point_begin[p + 1];
     }
-    entries.clear();
-    if (observation.rig_block >= 0) {
-      entries.emplace_back(observation.rig_block,
-                           PoseTangentJacobian(j_rig, observation.rig_pose));
-    }
-    if (observation.cam_block >= 0) {
-      entries.emplace_back(observation.cam_block,
-                           PoseTangentJacobian(j_cam, observation.cam_pose));
-    }
-    if (observation.intrinsics_block >= 0) {
-      const std::vector<int>& free = *observation.free_intrinsics;
-      Eigen::MatrixXd jacobian(2, free.size());
-      for (size_t k = 0; k < free.size(); ++k) {
-        jacobian(0, k) = j_intrinsics[free[k]];
-        jacobian(1, k) = j_intrinsics[num_params + free[k]];
+  }
+  if (point_begin[num_points] > first) {
+    ranges.emplace_back(first, point_begin[num_points]);
+  }
+  for (first = point_begin[num_points]; first < order.size(); first += target) {
+    ranges.emplace_back(first, std::min(order.size(), first + target));
+  }
+
+  std::vector<AccumulationChunk> chunks(ranges.size());
+  const int num_chunks = static_cast<int>(chunks.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+  for (int c = 0; c < num_chunks; ++c) {
+    AccumulationChunk& chunk = chunks[c];
+    chunk.reduced = std::make_unique<BlockMatrix>(blocks_);
+    chunk.distances.assign(distances_.size(), {});
+    for (size_t k = ranges[c].first; k < ranges[c].second; ++k) {
+      const Observation& observation = observations_[order[k]];
+      const int p = observation.point_index;
+      AccumulateObservation(observation, p >= 0 ? &points_[p] : nullptr,
+                            &chunk);
+      if (p >= 0 && k + 1 == point_begin[p + 1]) {
+        EliminatePoint(&points_[p], &chunk);
       }
-      entries.emplace_back(observation.intrinsics_block, jacobian);
     }
-    for (size_t i = 0; i < entries.size(); ++i) {
-      for (size_t j = i; j < entries.size(); ++j) {
-        reduced_->Add(entries[i].first, entries[j].first,
-                      entries[i].second.transpose() * entries[j].second);
-      }
-    }
-    if (observation.point_index >= 0) {
-      PointTerms& point = points_[observation.point_index];
-      point.information += j_point.transpose() * j_point;
-      for (const auto& [block, jacobian] : entries) {
-        point.Cross(block, blocks_[block].dim) +=
-            j_point.transpose() * jacobian;
-      }
+  }
+  reduced_ = std::make_unique<BlockMatrix>(blocks_);
+  int64_t num_used = 0;
+  for (AccumulationChunk& chunk : chunks) {
+    reduced_->AddAll(*chunk.reduced);
+    chunk.reduced.reset();
+    sum_squared_ += chunk.sum_squared;
+    sum_meat_ += chunk.sum_meat;
+    sum_bread_ += chunk.sum_bread;
+    num_used += chunk.num_used;
+    num_parameters_ += chunk.num_point_parameters;
+    for (size_t camera = 0; camera < distances_.size(); ++camera) {
+      distances_[camera].insert(distances_[camera].end(),
+                                chunk.distances[camera].begin(),
+                                chunk.distances[camera].end());
     }
   }
   num_residuals_ = 2 * num_used;
   return true;
-}
-
-// The Schur complement of the points: R -= W^T H_pp^+ W per point. A point
-// direction without information (e.g. along the ray of a point seen once)
-// has none in W either, so the pseudo-inverse is exact.
-void UncertaintyProblem::EliminatePoints() {
-  for (PointTerms& point : points_) {
-    int rank = 0;
-    point.pseudo_inverse = PointPseudoInverse(point.information, &rank);
-    num_parameters_ += rank;
-    for (size_t i = 0; i < point.cross.size(); ++i) {
-      const Eigen::MatrixXd left =
-          point.cross[i].second.transpose() * point.pseudo_inverse;
-      for (size_t j = i; j < point.cross.size(); ++j) {
-        reduced_->Add(point.cross[i].first, point.cross[j].first,
-                      -left * point.cross[j].second);
-      }
-    }
-  }
 }
 
 // With a free gauge, priors that fix it (any do, see the header): the first
@@ -981,7 +1090,6 @@ bool UncertaintyProblem::Run(const UncertaintyOptions& options,
     result->message = "a camera model without a cost function";
     return false;
   }
-  EliminatePoints();
   num_parameters_ += num_o_ + num_c_ - (free_gauge_ ? 7 : 0);
   result->num_residuals = num_residuals_;
   result->num_parameters = num_parameters_;

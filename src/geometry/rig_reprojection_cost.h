@@ -20,19 +20,20 @@
 //   dr/dt_Q = dr/dp R_P,                dr/dq_Q = dr/dp R_P dR(q_Q) X / dq_Q,
 //   dr/dX   = dr/dp R_P R_Q,
 // with y = R_Q X + t_Q and dR(q) p / dq from RotatedPointQuaternionJacobian.
-// Only pi_theta is differentiated with Jets (2 + kNumParams derivatives
-// instead of the 17 + kNumParams of a fully auto-differentiated functor):
-// the Jacobian evaluation dominates the final bundle adjustment.
+// pi_theta and its derivatives come from camera_model_jacobians.h (closed
+// form for the common models): the Jacobian evaluation dominates the final
+// bundle adjustment.
 // A point that is not in front of the camera (p_z <= 0) is an invalid
 // evaluation for Ceres (the step is rejected), not a NaN.
 #pragma once
 
 #include <ceres/cost_function.h>
-#include <ceres/jet.h>
 #include <colmap/base/pose.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "src/geometry/camera_model_jacobians.h"
 
 namespace rig_calibrator {
 
@@ -52,35 +53,6 @@ inline Eigen::Matrix<double, 3, 4> RotatedPointQuaternionJacobian(
       2 * (v * p.transpose() + v.dot(p) * Eigen::Matrix3d::Identity() -
            2 * p * v.transpose());
   return jacobian;
-}
-
-// The pixel pi_theta(u, v) of the COLMAP model CameraModel, with its
-// derivatives by (u, v) and, when `d_pixel_d_params` is given, by theta
-// (row-major 2 x kNumParams): forward-mode differentiation of the templated
-// CameraModel::WorldToImage with kNumDerivatives = 2 (u, v) or
-// 2 + kNumParams.
-template <typename CameraModel, int kNumDerivatives>
-void ProjectWithJacobians(const double* params, double u, double v,
-                          double* pixel, Eigen::Matrix2d* d_pixel_d_uv,
-                          double* d_pixel_d_params) {
-  using Jet = ceres::Jet<double, kNumDerivatives>;
-  constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
-  Jet jet_params[kNumParams];
-  for (int k = 0; k < kNumParams; ++k) {
-    jet_params[k] =
-        kNumDerivatives > 2 ? Jet(params[k], 2 + k) : Jet(params[k]);
-  }
-  Jet x, y;
-  CameraModel::WorldToImage(jet_params, Jet(u, 0), Jet(v, 1), &x, &y);
-  pixel[0] = x.a;
-  pixel[1] = y.a;
-  *d_pixel_d_uv << x.v[0], x.v[1], y.v[0], y.v[1];
-  if (d_pixel_d_params != nullptr) {
-    for (int k = 0; k < kNumParams; ++k) {
-      d_pixel_d_params[k] = x.v[2 + k];
-      d_pixel_d_params[kNumParams + k] = y.v[2 + k];
-    }
-  }
 }
 
 // r = pi_theta(P Q X) - x for the COLMAP model CameraModel (see the top of
@@ -135,13 +107,8 @@ class RigReprojectionCost final : public ceres::CostFunction {
     }
 
     Eigen::Matrix2d d_pixel_d_uv;
-    if (jacobians[2] != nullptr) {
-      ProjectWithJacobians<CameraModel, 2 + kNumParams>(
-          camera_params, u, v, residuals, &d_pixel_d_uv, jacobians[2]);
-    } else {
-      ProjectWithJacobians<CameraModel, 2>(camera_params, u, v, residuals,
-                                           &d_pixel_d_uv, nullptr);
-    }
+    ProjectWithJacobians<CameraModel>(camera_params, u, v, residuals,
+                                      &d_pixel_d_uv, jacobians[2]);
     residuals[0] -= observed_.x();
     residuals[1] -= observed_.y();
 

@@ -34,7 +34,8 @@
 // cost decrease is at least 1e-3 of the model's, rho = (F(x) - F(x')) /
 // (1/2 |r|^2 - 1/2 |r + J delta|^2); then mu /= max(1/3, 1 - (2 rho - 1)^3),
 // else mu is divided by a factor that doubles with every rejection in a row.
-// Stops when a step changes F by less than function_tolerance * F, when the
+// Stops when a step changes F by less than function_tolerance * F (an
+// accepted one is kept, without linearizing there), when the
 // step is below parameter_tolerance * (|x| + parameter_tolerance), when the
 // gradient's largest entry is below gradient_tolerance, or after
 // max_num_iterations steps (accepted or not).
@@ -64,7 +65,9 @@ struct BundleLevenbergMarquardtOptions {
   double gradient_tolerance = 1e-10;
   double initial_trust_region_radius = 1e4;
   int num_threads = -1;  // -1: all cores; the result does not depend on it
-  bool print_progress = false;  // one line per iteration on stdout
+  // One line per iteration on stdout (Ceres' columns; |gradient| is nan on
+  // the line of an accepted step that ends the solve: not evaluated there).
+  bool print_progress = false;
 };
 
 struct BundleLevenbergMarquardtSummary {

@@ -30,6 +30,7 @@ check "2 calibration runs in the CSV" test "$(wc -l < "$work/out/runtime_calibra
 check "2 baseline runs in the CSV" test "$(wc -l < "$work/out/runtime_calibration_before.csv")" -eq 3
 check "iteration columns" grep -q '"Final bundle adjustment iterations"' "$work/out/runtime_calibration.csv"
 check "before/after table" grep -q '^| \*\*total\*\* |' "$work/out/runtime.md"
+check "medians of the 2 repeats" grep -q '2 times alternating; every time is the median' "$work/out/runtime.md"
 check "core count and load noted" grep -q 'cores online; load average' "$work/out/runtime.md"
 for file in colmap_rig_ba.md colmap_rig_ba.csv; do
   check "$file written" test -s "$work/out/$file"

@@ -37,6 +37,31 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
+TEST(RuntimeBenchmark, MedianOfRepeatsPerStage) {
+  std::vector<CalibrationRuntime> runs = {MakeRun(10, 5, 30), MakeRun(10, 5, 9),
+                                          MakeRun(10, 5, 12)};
+  runs[1].peak_memory_mb = 200;
+  runs[2].stages[0].seconds = 0.1;  // localization fastest in another run
+  const CalibrationRuntime median = MedianCalibrationRuntime(runs);
+  ASSERT_TRUE(median.success);
+  EXPECT_DOUBLE_EQ(median.cpu_seconds, 12);
+  EXPECT_DOUBLE_EQ(median.seconds, 12 / 1.5);
+  ASSERT_EQ(median.stages.size(), 2u);
+  EXPECT_DOUBLE_EQ(median.stages[0].seconds, 0.5);
+  EXPECT_DOUBLE_EQ(median.stages[1].seconds, 12.0 / 3);
+  EXPECT_DOUBLE_EQ(median.stages[1].cpu_seconds, 12.0 / 2);
+  EXPECT_EQ(median.stages[1].num_iterations, 17);
+  EXPECT_DOUBLE_EQ(median.peak_memory_mb, 200);
+  // An even count: the mean of the middle two.
+  runs.pop_back();
+  EXPECT_DOUBLE_EQ(MedianCalibrationRuntime(runs).cpu_seconds, (30 + 9) / 2.0);
+  // A failed run stands for all.
+  runs[1].success = false;
+  runs[1].error = "diverged";
+  EXPECT_FALSE(MedianCalibrationRuntime(runs).success);
+  EXPECT_EQ(MedianCalibrationRuntime(runs).error, "diverged");
+}
+
 TEST(RuntimeBenchmark, CalibrationRuntimeRoundTrips) {
   CalibrationRuntime run = MakeRun(500, 10, 41.5);
   run.success = false;

@@ -190,6 +190,35 @@ TEST(CalibrationUncertainty, ExactDataGiveZeroSigmaAndNoNaN) {
   }
 }
 
+TEST(CalibrationUncertainty, ResultDoesNotDependOnThreadCount) {
+  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
+  options.num_map_images = 24;
+  SyntheticRig rig = GenerateSyntheticRig(options);
+  KeepPointsWithTracks(&rig);
+  FinalBundleAdjustmentOptions ba = MapAdjustment();
+  RigCalibration calibration = StartAtTruth(rig);
+  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
+  std::vector<CalibrationUncertainty> results;
+  for (const int num_threads : {1, 2, 3}) {
+    ba.num_threads = num_threads;
+    results.push_back(
+        EstimateCalibrationUncertainty(ba, rig.dataset, calibration));
+    ASSERT_TRUE(results.back().computed) << results.back().message;
+  }
+  for (size_t k = 1; k < results.size(); ++k) {
+    EXPECT_EQ(results[k].residual_scale_px, results[0].residual_scale_px);
+    EXPECT_EQ(results[k].effective_scale_px, results[0].effective_scale_px);
+    EXPECT_EQ(results[k].num_parameters, results[0].num_parameters);
+    ASSERT_EQ(results[k].cameras.size(), results[0].cameras.size());
+    for (size_t c = 0; c < results[0].cameras.size(); ++c) {
+      EXPECT_EQ(results[k].cameras[c].covariance,
+                results[0].cameras[c].covariance);
+      EXPECT_EQ(results[k].cameras[c].projection.stddev_px,
+                results[0].cameras[c].projection.stddev_px);
+    }
+  }
+}
+
 TEST(CalibrationUncertainty, HeldParametersHaveZeroSigmaReferenceCameraToo) {
   const SyntheticRig rig = GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 4));
   FinalBundleAdjustmentOptions ba = QuietAdjustment();

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <atomic>
 #include <memory>
 #include <random>
 #include <vector>
@@ -391,6 +392,64 @@ TEST(BundleLevenbergMarquardtTest, StopsAtTheIterationLimitAndContinues) {
   EXPECT_EQ(second.reduced_system_size, first.reduced_system_size);
   EXPECT_EQ(second.initial_cost, first.final_cost);
   EXPECT_LT(second.final_cost, first.final_cost);
+}
+
+// Counts the evaluations with Jacobians of the wrapped cost: one per
+// linearization pass of the solver.
+class CountingCost final : public ceres::CostFunction {
+ public:
+  CountingCost(const ceres::CostFunction* cost, std::atomic<int>* count)
+      : cost_(cost), count_(count) {
+    set_num_residuals(cost->num_residuals());
+    *mutable_parameter_block_sizes() = cost->parameter_block_sizes();
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    if (jacobians != nullptr) ++*count_;
+    return cost_->Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  const ceres::CostFunction* cost_;
+  std::atomic<int>* count_;
+};
+
+TEST(BundleLevenbergMarquardtTest, ConvergedStepIsKeptWithoutRelinearizing) {
+  const Scene truth = MakeScene(0.5, 0, 10);
+  Scene scene = Perturbed(truth, 11);
+  Problem problem;
+  BuildProblem(&scene, &problem);
+  std::atomic<int> num_linearizations{0};
+  const CountingCost counting(problem.costs[0].get(), &num_linearizations);
+  BundleLevenbergMarquardtOptions options;
+  options.function_tolerance = 1e-3;
+  BundleLevenbergMarquardt solver(options);
+  solver.AddParameterBlock(scene.intrinsics[0].data(), 4, nullptr, 0);
+  solver.AddParameterBlock(scene.cam_from_rig[1].data(), 7,
+                           &problem.pose_manifold, 1);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    solver.AddResidualBlock(k == 0 ? &counting : problem.costs[k].get(),
+                            nullptr, problem.parameters[k]);
+  }
+  BundleLevenbergMarquardtSummary summary;
+  solver.Solve(&summary);
+  ASSERT_EQ(summary.termination,
+            BundleLevenbergMarquardtSummary::Termination::kConvergence)
+      << summary.BriefReport();
+  EXPECT_EQ(summary.message, "function tolerance reached");
+  ASSERT_GE(summary.num_successful_steps, 1);
+  // The start and every accepted step but the last, which ends the solve.
+  EXPECT_EQ(num_linearizations.load(), summary.num_successful_steps);
+  // The parameters are those of the last accepted step: its cost.
+  double cost = 0;
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    Eigen::Vector2d residual;
+    ASSERT_TRUE(problem.costs[k]->Evaluate(problem.parameters[k].data(),
+                                           residual.data(), nullptr));
+    cost += 0.5 * residual.squaredNorm();
+  }
+  EXPECT_NEAR(cost, summary.final_cost, 1e-9 * cost);
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
 }
 
 }  // namespace
