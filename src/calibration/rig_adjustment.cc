@@ -117,7 +117,7 @@ RigAdjustment::ObservationError RigAdjustment::Evaluate(
   const Rigid3d cam_from_world =
       FromPoseParams(cam_from_rig_[image.camera_index]) *
       FromPoseParams(rig_from_world_[image.frameset_index]);
-  const Eigen::Vector3d point_in_cam = cam_from_world * PointOf(correspondence);
+  const Eigen::Vector3d point_in_cam = cam_from_world * PointOf(observation);
   ObservationError error;
   error.depth = point_in_cam.z();
   if (error.depth > 0) {
@@ -187,52 +187,71 @@ bool RigAdjustment::IsPointRefined(int64_t point3D_id) const {
 }
 
 const Eigen::Vector3d& RigAdjustment::PointOf(
-    const Correspondence& correspondence) const {
-  if (correspondence.point3D_id >= 0) {
-    if (const Eigen::Vector3d* refined =
-            RefinedPoint(correspondence.point3D_id)) {
-      return *refined;
-    }
-  }
-  return correspondence.point3D;
-}
-
-bool RigAdjustment::IsPointRefined(const Correspondence& correspondence) const {
-  return IsPointRefined(correspondence.point3D_id);
+    const Observation& observation) const {
+  return observation.refined_slot >= 0
+             ? refined_points_[observation.refined_slot]
+             : CorrespondenceOf(observation).point3D;
 }
 
 void RigAdjustment::SelectRefinedPoints() {
+  const bool first_selection = !points_selected_;
   points_selected_ = true;
-  // Per point: observations by rig images, then by map images.
-  std::unordered_map<int64_t, std::pair<int, int>> num_observations;
-  // Fewer points than observations: no rehash while counting.
-  num_observations.reserve(observations_.size());
-  for (const Observation& observation : observations_) {
-    const Correspondence& correspondence = CorrespondenceOf(observation);
-    if (correspondence.point3D_id >= 0) {
-      ++num_observations[correspondence.point3D_id].first;
-      map_points_.emplace(correspondence.point3D_id, correspondence.point3D);
+  // The rig observations' points, sorted by id (runs of one point), with the
+  // observation: counting by sorting, not hashing, 945 000 observations
+  // at 500 framesets x 10 cameras.
+  std::vector<std::pair<int64_t, size_t>> rig_ids;
+  rig_ids.reserve(observations_.size());
+  for (size_t k = 0; k < observations_.size(); ++k) {
+    observations_[k].refined_slot = -1;
+    const int64_t point3D_id = CorrespondenceOf(observations_[k]).point3D_id;
+    if (point3D_id >= 0) rig_ids.emplace_back(point3D_id, k);
+  }
+  std::sort(rig_ids.begin(), rig_ids.end());
+  const auto seen_by_rig = [&](int64_t point3D_id) {
+    const auto it = std::lower_bound(rig_ids.begin(), rig_ids.end(), point3D_id,
+                                     [](const std::pair<int64_t, size_t>& a,
+                                        int64_t id) { return a.first < id; });
+    return it != rig_ids.end() && it->first == point3D_id;
+  };
+  // Observations only ever leave: the first selection sees every point.
+  if (first_selection) {
+    for (size_t k = 0; k < rig_ids.size(); ++k) {
+      if (k == 0 || rig_ids[k].first != rig_ids[k - 1].first) {
+        map_points_.emplace(
+            rig_ids[k].first,
+            CorrespondenceOf(observations_[rig_ids[k].second]).point3D);
+      }
     }
   }
+  // The map images' current observations of points: all with refine_map,
+  // else those of points the rig images see.
+  std::vector<int64_t> map_ids;
   for (size_t i = 0; options_.use_map_observations && i < map_rejected_.size();
        ++i) {
     const MapImage& image = dataset_.map_images[i];
     for (size_t k = 0; k < image.observations.size(); ++k) {
       const int64_t point3D_id = image.observations[k].point3D_id;
-      if (map_rejected_[i][k]) continue;
-      if (options_.refine_map) {
-        ++num_observations[point3D_id].second;
-      } else if (const auto it = num_observations.find(point3D_id);
-                 it != num_observations.end()) {
-        ++it->second.second;
+      if (!map_rejected_[i][k] &&
+          (options_.refine_map || seen_by_rig(point3D_id))) {
+        map_ids.push_back(point3D_id);
       }
     }
   }
+  std::sort(map_ids.begin(), map_ids.end());
+  // Points with two observations or more, in increasing id: a merge of the
+  // two sorted lists.
   std::vector<int64_t> refined_ids;
-  for (const auto& [point3D_id, counts] : num_observations) {
-    if (counts.first + counts.second >= 2) refined_ids.push_back(point3D_id);
+  for (size_t i = 0, j = 0; i < rig_ids.size() || j < map_ids.size();) {
+    const int64_t point3D_id =
+        j == map_ids.size() ||
+                (i < rig_ids.size() && rig_ids[i].first < map_ids[j])
+            ? rig_ids[i].first
+            : map_ids[j];
+    int count = 0;
+    for (; i < rig_ids.size() && rig_ids[i].first == point3D_id; ++i) ++count;
+    for (; j < map_ids.size() && map_ids[j] == point3D_id; ++j) ++count;
+    if (count >= 2) refined_ids.push_back(point3D_id);
   }
-  std::sort(refined_ids.begin(), refined_ids.end());
   std::vector<Eigen::Vector3d> refined_points;
   refined_points.reserve(refined_ids.size());
   std::unordered_map<int64_t, size_t> refined_point_index;
@@ -245,6 +264,14 @@ void RigAdjustment::SelectRefinedPoints() {
   }
   refined_points_ = std::move(refined_points);
   refined_point_index_ = std::move(refined_point_index);
+  // The rig observations' slots: both lists are sorted by id.
+  size_t slot = 0;
+  for (const auto& [point3D_id, observation] : rig_ids) {
+    while (slot < refined_ids.size() && refined_ids[slot] < point3D_id) ++slot;
+    if (slot < refined_ids.size() && refined_ids[slot] == point3D_id) {
+      observations_[observation].refined_slot = static_cast<int64_t>(slot);
+    }
+  }
 }
 
 void RigAdjustment::WriteTo(RigCalibration* calibration) const {

@@ -83,6 +83,9 @@ class RigAdjustment {
     int correspondence = -1;
     std::unique_ptr<ceres::CostFunction> cost;
     bool cost_has_refined_point = false;
+    // Its point's slot in refined_points_ (SelectRefinedPoints), -1: the
+    // point is held at its map position.
+    int64_t refined_slot = -1;
   };
   // One observation of a map image (dataset.map_images).
   struct MapObservationRef {
@@ -108,9 +111,8 @@ class RigAdjustment {
   std::vector<MapObservationRef> MapObservationsOfRefinedPoints() const;
   std::vector<MapObservationRef> MapObservationsInProblem() const;
   // The refined position of the observed point, else its map position.
-  const Eigen::Vector3d& PointOf(const Correspondence& correspondence) const;
+  const Eigen::Vector3d& PointOf(const Observation& observation) const;
   const Eigen::Vector3d& PointOf(int64_t point3D_id) const;
-  bool IsPointRefined(const Correspondence& correspondence) const;
   bool IsPointRefined(int64_t point3D_id) const;
   // The points to refine in the next solve: those with an id that have at
   // least two current observations (seen once, a point has 3 unknowns for 2

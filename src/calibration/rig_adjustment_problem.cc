@@ -60,7 +60,7 @@ void RigAdjustment::AddResidualBlocks(
     colmap::Camera& camera = cameras_[image.camera_index];
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
-    const bool refined = IsPointRefined(correspondence);
+    const bool refined = observation.refined_slot >= 0;
     if (observation.cost == nullptr ||
         observation.cost_has_refined_point != refined) {
       observation.cost.reset(CreateRigReprojectionCost(
@@ -72,7 +72,7 @@ void RigAdjustment::AddResidualBlocks(
       solver->AddResidualBlock(
           observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData(),
-           RefinedPoint(correspondence.point3D_id)->data()});
+           refined_points_[observation.refined_slot].data()});
     } else {
       has_fixed_points_ = true;
       solver->AddResidualBlock(
