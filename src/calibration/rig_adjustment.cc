@@ -252,6 +252,10 @@ void RigAdjustment::SelectRefinedPoints() {
     for (; j < map_ids.size() && map_ids[j] == point3D_id; ++j) ++count;
     if (count >= 2) refined_ids.push_back(point3D_id);
   }
+  if (solver_ != nullptr) {
+    HoldPointsNoLongerRefined(refined_ids, rig_ids);
+    return;
+  }
   std::vector<Eigen::Vector3d> refined_points;
   refined_points.reserve(refined_ids.size());
   std::unordered_map<int64_t, size_t> refined_point_index;
@@ -270,6 +274,36 @@ void RigAdjustment::SelectRefinedPoints() {
     while (slot < refined_ids.size() && refined_ids[slot] < point3D_id) ++slot;
     if (slot < refined_ids.size() && refined_ids[slot] == point3D_id) {
       observations_[observation].refined_slot = static_cast<int64_t>(slot);
+    }
+  }
+}
+
+// With the problem built, the points keep their slots (the solver holds
+// their addresses): a point that is no longer refined goes back to its map
+// position, held by the solver, and leaves refined_point_index_. Observations
+// only ever leave, so no point becomes refined again.
+void RigAdjustment::HoldPointsNoLongerRefined(
+    const std::vector<int64_t>& refined_ids,
+    const std::vector<std::pair<int64_t, size_t>>& rig_ids) {
+  for (auto it = refined_point_index_.begin();
+       it != refined_point_index_.end();) {
+    if (std::binary_search(refined_ids.begin(), refined_ids.end(), it->first)) {
+      ++it;
+      continue;
+    }
+    Eigen::Vector3d& point = refined_points_[it->second];
+    point = map_points_.at(it->first);
+    solver_->SetPointHeld(point.data(), true);
+    it = refined_point_index_.erase(it);
+  }
+  for (size_t k = 0; k < rig_ids.size();) {
+    const auto it = refined_point_index_.find(rig_ids[k].first);
+    const int64_t slot = it != refined_point_index_.end()
+                             ? static_cast<int64_t>(it->second)
+                             : -1;
+    for (const int64_t point3D_id = rig_ids[k].first;
+         k < rig_ids.size() && rig_ids[k].first == point3D_id; ++k) {
+      observations_[rig_ids[k].second].refined_slot = slot;
     }
   }
 }

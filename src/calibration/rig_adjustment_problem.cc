@@ -15,26 +15,30 @@ bool RigAdjustment::Solve(double function_tolerance,
   if (options_.refine_points) {
     SelectRefinedPoints();
   }
-  BundleLevenbergMarquardtOptions solver_options;
-  solver_options.max_num_iterations = options_.max_num_iterations;
-  solver_options.function_tolerance = function_tolerance;
-  // Exact data converges quadratically; a parameter tolerance relative to
-  // the whole parameter vector (dominated by the focal lengths) of Ceres'
-  // default 1e-8 would stop a few digits short.
-  solver_options.parameter_tolerance = 1e-12;
-  solver_options.num_threads = options_.num_threads;
-  solver_options.print_progress = options_.print_progress;
-  BundleLevenbergMarquardt solver(solver_options);
-  const std::vector<MapObservationRef> map_observations =
-      MapObservationsInProblem();
-  solver.Reserve(observations_.size() + map_observations.size(),
-                 refined_points_.size());
-  AddParameterBlocks(map_observations, &solver);
-  std::vector<std::unique_ptr<ceres::CostFunction>> map_costs;
-  AddResidualBlocks(map_observations, &solver, &map_costs);
+  if (solver_ == nullptr) {
+    BundleLevenbergMarquardtOptions solver_options;
+    solver_options.max_num_iterations = options_.max_num_iterations;
+    // Exact data converges quadratically; a parameter tolerance relative to
+    // the whole parameter vector (dominated by the focal lengths) of Ceres'
+    // default 1e-8 would stop a few digits short.
+    solver_options.parameter_tolerance = 1e-12;
+    solver_options.num_threads = options_.num_threads;
+    solver_options.print_progress = options_.print_progress;
+    solver_ = std::make_unique<BundleLevenbergMarquardt>(solver_options);
+    const std::vector<MapObservationRef> map_observations =
+        MapObservationsInProblem();
+    solver_->Reserve(observations_.size() + map_observations.size(),
+                     refined_points_.size());
+    AddParameterBlocks(map_observations);
+    AddResidualBlocks(map_observations);
+  } else {
+    UpdateResidualBlocks();
+  }
+  solver_->SetFunctionTolerance(function_tolerance);
   VLOG(1) << "Final bundle adjustment: "
-          << observations_.size() + map_costs.size() << " observations";
-  solver.Solve(summary);
+          << observations_.size() + NumMapObservationsInProblem()
+          << " observations";
+  solver_->Solve(summary);
   VLOG(1) << summary->BriefReport() << "; " << summary->seconds
           << " s: structure " << summary->structure_seconds << " s, evaluation "
           << summary->evaluation_seconds << " s, reduced system "
@@ -49,11 +53,13 @@ bool RigAdjustment::Solve(double function_tolerance,
   return true;
 }
 
+// A rig observation of a refined point has it as its fourth block; when the
+// point is later held (UpdateResidualBlocks), the solver treats it as a
+// constant, the same residual as one made with the point fixed.
 void RigAdjustment::AddResidualBlocks(
-    const std::vector<MapObservationRef>& map_observations,
-    BundleLevenbergMarquardt* solver,
-    std::vector<std::unique_ptr<ceres::CostFunction>>* map_costs) {
+    const std::vector<MapObservationRef>& map_observations) {
   has_fixed_points_ = false;
+  num_rig_residuals_ = observations_.size();
   for (Observation& observation : observations_) {
     const RigImage& image = dataset_.images[observation.image];
     const Correspondence& correspondence = CorrespondenceOf(observation);
@@ -61,38 +67,57 @@ void RigAdjustment::AddResidualBlocks(
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
     const bool refined = observation.refined_slot >= 0;
-    if (observation.cost == nullptr ||
-        observation.cost_has_refined_point != refined) {
-      observation.cost.reset(CreateRigReprojectionCost(
-          camera.ModelId(), correspondence.point2D,
-          refined ? nullptr : &correspondence.point3D));
-      observation.cost_has_refined_point = refined;
-    }
+    observation.cost.reset(
+        CreateRigReprojectionCost(camera.ModelId(), correspondence.point2D,
+                                  refined ? nullptr : &correspondence.point3D));
     if (refined) {
-      solver->AddResidualBlock(
+      observation.residual_index = solver_->AddResidualBlock(
           observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData(),
            refined_points_[observation.refined_slot].data()});
     } else {
       has_fixed_points_ = true;
-      solver->AddResidualBlock(
+      observation.residual_index = solver_->AddResidualBlock(
           observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
   }
-  map_costs->reserve(map_observations.size());
+  map_costs_.reserve(map_observations.size());
+  map_residuals_.reserve(map_observations.size());
   for (const MapObservationRef& observation : map_observations) {
     const MapObservation& map_observation = MapObservationOf(observation);
     colmap::Camera& camera =
         map_cameras_[dataset_.map_images[observation.image].camera_index];
-    map_costs->emplace_back(CreateRigReprojectionCost(
+    map_costs_.emplace_back(CreateRigReprojectionCost(
         camera.ModelId(), map_observation.point2D, nullptr));
-    solver->AddResidualBlock(
-        map_costs->back().get(), loss_.get(),
-        {map_cam_from_world_[observation.image].data(), identity_pose_.data(),
-         camera.ParamsData(),
-         RefinedPoint(map_observation.point3D_id)->data()});
+    map_residuals_.emplace_back(
+        observation, solver_->AddResidualBlock(
+                         map_costs_.back().get(), loss_.get(),
+                         {map_cam_from_world_[observation.image].data(),
+                          identity_pose_.data(), camera.ParamsData(),
+                          RefinedPoint(map_observation.point3D_id)->data()}));
     has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
+  }
+}
+
+void RigAdjustment::UpdateResidualBlocks() {
+  // The rig observations' blocks are the first num_rig_residuals_.
+  std::vector<char> active(num_rig_residuals_, 0);
+  has_fixed_points_ = false;
+  for (const Observation& observation : observations_) {
+    active[observation.residual_index] = 1;
+    has_fixed_points_ = has_fixed_points_ || observation.refined_slot < 0;
+  }
+  for (const auto& [observation, index] : map_residuals_) {
+    const bool in_problem =
+        !map_rejected_[observation.image][observation.observation] &&
+        IsPointRefined(MapObservationOf(observation).point3D_id);
+    solver_->SetResidualBlockActive(index, in_problem);
+    has_fixed_points_ =
+        has_fixed_points_ || (in_problem && !options_.refine_map);
+  }
+  for (size_t index = 0; index < active.size(); ++index) {
+    solver_->SetResidualBlockActive(index, active[index] != 0);
   }
 }
 
@@ -102,8 +127,7 @@ void RigAdjustment::AddResidualBlocks(
 // camera's intrinsics. Blocks that are not added are held constant. The
 // points are added in point3D_id order.
 void RigAdjustment::AddParameterBlocks(
-    const std::vector<MapObservationRef>& map_observations,
-    BundleLevenbergMarquardt* solver) {
+    const std::vector<MapObservationRef>& map_observations) {
   // Only the blocks that the observations use.
   std::vector<char> frameset_used(rig_from_world_.size(), 0);
   std::vector<char> camera_used(cameras_.size(), 0);
@@ -122,21 +146,21 @@ void RigAdjustment::AddParameterBlocks(
   if (options_.refine_rig_poses) {
     for (size_t frameset = 0; frameset < rig_from_world_.size(); ++frameset) {
       if (!frameset_used[frameset]) continue;
-      solver->AddParameterBlock(rig_from_world_[frameset].data(), 7,
-                                pose_manifold_.get(), group++);
+      solver_->AddParameterBlock(rig_from_world_[frameset].data(), 7,
+                                 pose_manifold_.get(), group++);
     }
   }
   if (options_.refine_map) {
     for (size_t image = 0; image < map_cam_from_world_.size(); ++image) {
       if (!map_image_used[image]) continue;
-      solver->AddParameterBlock(map_cam_from_world_[image].data(), 7,
-                                pose_manifold_.get(), group++);
+      solver_->AddParameterBlock(map_cam_from_world_[image].data(), 7,
+                                 pose_manifold_.get(), group++);
     }
     for (size_t camera = 0;
          options_.refine_map_intrinsics && camera < map_cameras_.size();
          ++camera) {
       if (!map_camera_used[camera]) continue;
-      solver->AddParameterBlock(
+      solver_->AddParameterBlock(
           map_cameras_[camera].ParamsData(),
           static_cast<int>(map_cameras_[camera].NumParams()), nullptr, group++);
     }
@@ -147,8 +171,8 @@ void RigAdjustment::AddParameterBlocks(
     bool in_group = false;
     if (options_.refine_extrinsics &&
         static_cast<int>(camera) != dataset_.reference_camera) {
-      solver->AddParameterBlock(cam_from_rig_[camera].data(), 7,
-                                pose_manifold_.get(), group);
+      solver_->AddParameterBlock(cam_from_rig_[camera].data(), 7,
+                                 pose_manifold_.get(), group);
       in_group = true;
     }
     const IntrinsicsRefinement method_refinement = {
@@ -165,14 +189,14 @@ void RigAdjustment::AddParameterBlocks(
             num_params, constant_params));
         manifold = intrinsics_manifolds_.back().get();
       }
-      solver->AddParameterBlock(cameras_[camera].ParamsData(), num_params,
-                                manifold, group);
+      solver_->AddParameterBlock(cameras_[camera].ParamsData(), num_params,
+                                 manifold, group);
       in_group = true;
     }
     group += in_group ? 1 : 0;
   }
   for (Eigen::Vector3d& point : refined_points_) {
-    solver->AddPoint(point.data());
+    solver_->AddPoint(point.data());
   }
 }
 

@@ -152,6 +152,7 @@ struct BundleLevenbergMarquardt::Impl {
     int num_parameters = 0;
     int point = -1;            // refined point, or -1
     int point_parameter = -1;  // its position in `parameters`
+    bool active = true;        // SetResidualBlockActive
     // The distinct groups of its blocks (ascending), where their corrected
     // 2 x group-size Jacobians are in `jacobians` (rows of its batch's
     // stacked ones) and where the point's 2 x 3 is.
@@ -205,10 +206,13 @@ struct BundleLevenbergMarquardt::Impl {
   std::array<std::pair<const double*, int>, kMaxParametersPerResidual>
       last_block{};
   std::vector<double*> points;
+  std::vector<char> point_held;  // SetPointHeld
   std::unordered_map<const double*, int> point_index;
   std::vector<Residual> residuals;
 
-  // Structure (Solve).
+  // Structure (Solve), built at the first Solve after a block, point or
+  // residual was added.
+  bool structure_valid = false;
   std::vector<size_t> residual_order;  // by point, pointless ones last
   std::vector<size_t> point_residuals_begin;
   std::vector<size_t> point_groups_begin, point_pairs_begin;
@@ -612,6 +616,21 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
 bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
     const Residual& residual, bool linearize, std::vector<double>* scratch,
     double* cost, double* residual_out, double* jacobian_base) const {
+  // Inactive: zero residuals and Jacobians, as if it were not there.
+  if (!residual.active) {
+    if (linearize) {
+      residual_out[0] = residual_out[1] = 0;
+      for (int g = 0; g < residual.num_groups; ++g) {
+        double* out = jacobian_base + residual.group_jacobian[g];
+        std::fill(out, out + 2 * groups[residual.groups[g]].size, 0.0);
+      }
+      if (residual.point >= 0) {
+        std::fill(jacobian_base + residual.point_jacobian,
+                  jacobian_base + residual.point_jacobian + 6, 0.0);
+      }
+    }
+    return true;
+  }
   // Ambient Jacobians of the refined parameters, in `scratch`.
   std::array<double*, kMaxParametersPerResidual> ambient{};
   if (linearize) {
@@ -692,9 +711,13 @@ bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
   }
   if (residual.point >= 0) {
     double* out = jacobian_base + residual.point_jacobian;
-    std::copy(ambient[residual.point_parameter],
-              ambient[residual.point_parameter] + 6, out);
-    correct(out, 3);
+    if (point_held[residual.point]) {
+      std::fill(out, out + 6, 0.0);  // a constant of this residual
+    } else {
+      std::copy(ambient[residual.point_parameter],
+                ambient[residual.point_parameter] + 6, out);
+      correct(out, 3);
+    }
   }
   return true;
 }
@@ -849,6 +872,7 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
     std::vector<double> y;  // V~^-1 W_pg, 3 x group size, per group
     std::vector<size_t> y_offset;
     for (int p = chunk.first_point; p < chunk.end_point; ++p) {
+      if (point_held[p]) continue;  // V_p, W_p and b_p are zero: no term
       const PointStructure structure = StructureOf(p);
       Eigen::Matrix3d v = Eigen::Map<const Eigen::Matrix3d>(&point_v[9 * p]);
       for (int i = 0; i < 3; ++i) {
@@ -927,6 +951,10 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
   const int num_points = static_cast<int>(points.size());
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int p = 0; p < num_points; ++p) {
+    if (point_held[p]) {
+      std::fill(&point_step[3 * p], &point_step[3 * p] + 3, 0.0);
+      continue;
+    }
     const PointStructure structure = StructureOf(p);
     Eigen::Vector3d right = -Eigen::Map<const Eigen::Vector3d>(&point_b[3 * p]);
     for (int i = 0; i < structure.num_groups; ++i) {
@@ -1015,6 +1043,7 @@ void BundleLevenbergMarquardt::AddParameterBlock(
   block.manifold = manifold;
   block.tangent_size = manifold != nullptr ? manifold->TangentSize() : size;
   block.group = group;
+  impl_->structure_valid = false;
   impl_->last_block.fill({nullptr, -1});
   impl_->block_index.emplace(values, static_cast<int>(impl_->blocks.size()));
   impl_->blocks.push_back(block);
@@ -1028,13 +1057,32 @@ void BundleLevenbergMarquardt::Reserve(size_t num_residual_blocks,
 }
 
 void BundleLevenbergMarquardt::AddPoint(double* values) {
+  impl_->structure_valid = false;
   impl_->point_index.emplace(values, static_cast<int>(impl_->points.size()));
   impl_->points.push_back(values);
+  impl_->point_held.push_back(0);
 }
 
-void BundleLevenbergMarquardt::AddResidualBlock(
+void BundleLevenbergMarquardt::SetPointHeld(const double* values, bool held) {
+  const auto point = impl_->point_index.find(values);
+  CHECK(point != impl_->point_index.end()) << "not a point of the problem";
+  impl_->point_held[point->second] = held ? 1 : 0;
+}
+
+void BundleLevenbergMarquardt::SetResidualBlockActive(size_t index,
+                                                      bool active) {
+  CHECK_LT(index, impl_->residuals.size());
+  impl_->residuals[index].active = active;
+}
+
+void BundleLevenbergMarquardt::SetFunctionTolerance(double tolerance) {
+  impl_->options.function_tolerance = tolerance;
+}
+
+size_t BundleLevenbergMarquardt::AddResidualBlock(
     const ceres::CostFunction* cost, const ceres::LossFunction* loss,
     const std::vector<double*>& parameters) {
+  impl_->structure_valid = false;
   CHECK_EQ(cost->num_residuals(), 2);
   CHECK_LE(parameters.size(), kMaxParametersPerResidual);
   CHECK_EQ(parameters.size(), cost->parameter_block_sizes().size());
@@ -1067,6 +1115,7 @@ void BundleLevenbergMarquardt::AddResidualBlock(
     }
   }
   impl_->residuals.push_back(std::move(residual));
+  return impl_->residuals.size() - 1;
 }
 
 void BundleLevenbergMarquardt::Solve(BundleLevenbergMarquardtSummary* summary) {
@@ -1075,8 +1124,11 @@ void BundleLevenbergMarquardt::Solve(BundleLevenbergMarquardtSummary* summary) {
   const BundleLevenbergMarquardtOptions& options = impl.options;
   const auto start_time = std::chrono::steady_clock::now();
   *summary = BundleLevenbergMarquardtSummary();
-  summary->num_residual_blocks = static_cast<int>(impl.residuals.size());
-  summary->num_points = static_cast<int>(impl.points.size());
+  summary->num_residual_blocks = static_cast<int>(std::count_if(
+      impl.residuals.begin(), impl.residuals.end(),
+      [](const Impl::Residual& residual) { return residual.active; }));
+  summary->num_points = static_cast<int>(
+      std::count(impl.point_held.begin(), impl.point_held.end(), 0));
   const auto finish = [&](Termination termination, const std::string& message,
                           double cost) {
     summary->termination = termination;
@@ -1085,11 +1137,13 @@ void BundleLevenbergMarquardt::Solve(BundleLevenbergMarquardtSummary* summary) {
     summary->seconds = Seconds(start_time);
   };
   std::string error;
-  const bool structure_built = impl.BuildStructure(&error);
-  summary->structure_seconds = Seconds(start_time);
-  if (!structure_built) {
-    finish(Termination::kFailure, error, 0);
-    return;
+  if (!impl.structure_valid) {
+    impl.structure_valid = impl.BuildStructure(&error);
+    summary->structure_seconds = Seconds(start_time);
+    if (!impl.structure_valid) {
+      finish(Termination::kFailure, error, 0);
+      return;
+    }
   }
   summary->reduced_system_size = impl.reduced_size;
 

@@ -110,10 +110,22 @@ class BundleLevenbergMarquardt {
   // A residual block of 2 rows: `cost` over `parameters` (the pointers its
   // Evaluate takes, in its order). A pointer that was added as a parameter
   // block or a point is refined, any other is held constant. `loss` null:
-  // least squares. Neither is owned.
-  void AddResidualBlock(const ceres::CostFunction* cost,
-                        const ceres::LossFunction* loss,
-                        const std::vector<double*>& parameters);
+  // least squares. Neither is owned. Returns its index, from 0 in the order
+  // of addition.
+  size_t AddResidualBlock(const ceres::CostFunction* cost,
+                          const ceres::LossFunction* loss,
+                          const std::vector<double*>& parameters);
+
+  // Changes between solves that keep the structure (the reduced system's
+  // pattern and its symbolic factorization, built at the first Solve after
+  // an addition), for solves over a shrinking problem, e.g. after outlier
+  // pruning: an inactive residual block counts as removed (zero residual and
+  // Jacobian); a held point (added by AddPoint) is a constant of its
+  // residuals, as if it had not been added; the function tolerance of the
+  // next solves.
+  void SetResidualBlockActive(size_t index, bool active);
+  void SetPointHeld(const double* values, bool held);
+  void SetFunctionTolerance(double tolerance);
 
   // Minimizes F from the current values, which it updates (the last accepted
   // estimate, also when the solve fails midway).

@@ -452,5 +452,98 @@ TEST(BundleLevenbergMarquardtTest, ConvergedStepIsKeptWithoutRelinearizing) {
   EXPECT_LT(summary.final_cost, summary.initial_cost);
 }
 
+// Inactive residual blocks and held points, on the structure of an earlier
+// solve, give the solve of the problem without those blocks and with those
+// points constant.
+TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
+  const Scene truth = MakeScene(0.5, 0.1, 12);
+  Scene scene = Perturbed(truth, 13);
+  ceres::CauchyLoss loss(1.0);
+  Problem problem;
+  BuildProblem(&scene, &problem);
+  const int held_point = Scene::kNumFixedPoints + 5;
+  std::vector<char> removed(problem.costs.size(), 0);
+  for (size_t k = 0; k < removed.size(); k += 7) removed[k] = 1;
+  BundleLevenbergMarquardtOptions options;
+  options.parameter_tolerance = 1e-12;
+  options.function_tolerance = 1e-12;
+  BundleLevenbergMarquardt solver(options);
+  int group = 0;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    solver.AddParameterBlock(scene.rig_from_world[j].data(), 7,
+                             &problem.pose_manifold, group++);
+  }
+  solver.AddParameterBlock(scene.intrinsics[0].data(), 4, nullptr, group++);
+  solver.AddParameterBlock(scene.cam_from_rig[1].data(), 7,
+                           &problem.pose_manifold, group);
+  solver.AddParameterBlock(scene.intrinsics[1].data(), 4,
+                           &problem.principal_point_held, group++);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    solver.AddPoint(scene.points[p].data());
+  }
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    EXPECT_EQ(solver.AddResidualBlock(problem.costs[k].get(), &loss,
+                                      problem.parameters[k]),
+              k);
+  }
+  BundleLevenbergMarquardtSummary first;
+  solver.SetFunctionTolerance(1e-2);  // an early stop, as a pruning solve
+  solver.Solve(&first);
+  ASSERT_TRUE(first.IsSolutionUsable()) << first.BriefReport();
+  // Then without every 7th block and with one point back at the truth, held.
+  scene.points[held_point] = truth.points[held_point];
+  Scene reference = scene;
+  for (size_t k = 0; k < removed.size(); ++k) {
+    if (removed[k]) solver.SetResidualBlockActive(k, false);
+  }
+  solver.SetPointHeld(scene.points[held_point].data(), true);
+  solver.SetFunctionTolerance(1e-12);
+  BundleLevenbergMarquardtSummary second;
+  solver.Solve(&second);
+  ASSERT_TRUE(second.IsSolutionUsable()) << second.BriefReport();
+  EXPECT_EQ(second.structure_seconds, 0);  // the structure was kept
+  EXPECT_EQ(second.num_points, first.num_points - 1);
+
+  // The reference: a new solver over the reduced problem, from the same
+  // start.
+  Problem reference_problem;
+  BuildProblem(&reference, &reference_problem);
+  BundleLevenbergMarquardt reference_solver(options);
+  group = 0;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    reference_solver.AddParameterBlock(reference.rig_from_world[j].data(), 7,
+                                       &problem.pose_manifold, group++);
+  }
+  reference_solver.AddParameterBlock(reference.intrinsics[0].data(), 4, nullptr,
+                                     group++);
+  reference_solver.AddParameterBlock(reference.cam_from_rig[1].data(), 7,
+                                     &problem.pose_manifold, group);
+  reference_solver.AddParameterBlock(reference.intrinsics[1].data(), 4,
+                                     &problem.principal_point_held, group++);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    if (p != held_point) reference_solver.AddPoint(reference.points[p].data());
+  }
+  for (size_t k = 0; k < reference_problem.costs.size(); ++k) {
+    if (!removed[k]) {
+      reference_solver.AddResidualBlock(reference_problem.costs[k].get(), &loss,
+                                        reference_problem.parameters[k]);
+    }
+  }
+  BundleLevenbergMarquardtSummary expected;
+  reference_solver.Solve(&expected);
+  ASSERT_TRUE(expected.IsSolutionUsable()) << expected.BriefReport();
+  EXPECT_EQ(second.num_residual_blocks, expected.num_residual_blocks);
+  EXPECT_NEAR(second.initial_cost, expected.initial_cost,
+              1e-12 * expected.initial_cost);
+  EXPECT_NEAR(second.final_cost, expected.final_cost,
+              1e-9 * expected.final_cost);
+  EXPECT_EQ(scene.points[held_point], truth.points[held_point]);
+  const Errors between = Compare(scene, reference);
+  EXPECT_LT(between.rotation_rad, 1e-8);
+  EXPECT_LT(between.translation, 1e-7);
+  EXPECT_LT(between.point, 1e-6);
+  EXPECT_LT(between.focal_relative, 1e-9);
+}
+
 }  // namespace
 }  // namespace rig_calibrator
