@@ -72,6 +72,14 @@ void AddTangentialTerm(double u, double v, double p1, double p2, int p1_column,
   d->d_extra[kNumExtra + p1_column + 1] = 2 * u * v;
 }
 
+// The pinhole models: (x_d, y_d) = (u, v).
+inline Distorted<0> Undistorted(double u, double v) {
+  Distorted<0> d;
+  d.x = u;
+  d.y = v;
+  return d;
+}
+
 // SIMPLE_RADIAL: radial = k r2.
 inline Distorted<1> SimpleRadial(const double* k, double u, double v) {
   Distorted<1> d;
@@ -82,29 +90,29 @@ inline Distorted<1> SimpleRadial(const double* k, double u, double v) {
   return d;
 }
 
-// RADIAL: radial = k1 r2 + k2 r2^2.
-inline Distorted<2> Radial(const double* k, double u, double v) {
-  Distorted<2> d;
+// radial = k1 r2 + k2 r2^2 (RADIAL, OPENCV), k1 and k2 the first two
+// distortion parameters.
+template <int kNumExtra>
+Distorted<kNumExtra> TwoTermRadial(const double* k, double u, double v) {
+  Distorted<kNumExtra> d;
   const double r2 = u * u + v * v;
   AddRadialTerm(u, v, k[0] * r2 + k[1] * r2 * r2, k[0] + 2 * k[1] * r2, &d);
   d.d_extra[0] = u * r2;
   d.d_extra[1] = u * r2 * r2;
-  d.d_extra[2] = v * r2;
-  d.d_extra[3] = v * r2 * r2;
+  d.d_extra[kNumExtra] = v * r2;
+  d.d_extra[kNumExtra + 1] = v * r2 * r2;
   return d;
 }
 
-// OPENCV (k1, k2, p1, p2): radial = k1 r2 + k2 r2^2, plus the tangential
-// terms.
+// RADIAL (k1, k2).
+inline Distorted<2> Radial(const double* k, double u, double v) {
+  return TwoTermRadial<2>(k, u, v);
+}
+
+// OPENCV (k1, k2, p1, p2): the two radial terms plus the tangential ones.
 inline Distorted<4> OpenCV(const double* k, double u, double v) {
-  Distorted<4> d;
-  const double r2 = u * u + v * v;
-  AddRadialTerm(u, v, k[0] * r2 + k[1] * r2 * r2, k[0] + 2 * k[1] * r2, &d);
+  Distorted<4> d = TwoTermRadial<4>(k, u, v);
   AddTangentialTerm(u, v, k[2], k[3], 2, &d);
-  d.d_extra[0] = u * r2;
-  d.d_extra[1] = u * r2 * r2;
-  d.d_extra[4] = v * r2;
-  d.d_extra[5] = v * r2 * r2;
   return d;
 }
 
@@ -254,16 +262,12 @@ void ProjectWithJacobians(const double* params, double u, double v,
                           double* d_pixel_d_params) {
   namespace j = camera_model_jacobians;
   if constexpr (std::is_same_v<CameraModel, colmap::SimplePinholeCameraModel>) {
-    j::Distorted<0> d;
-    d.x = u;
-    d.y = v;
-    j::Project<1>(params, d, pixel, d_pixel_d_uv, d_pixel_d_params);
+    j::Project<1>(params, j::Undistorted(u, v), pixel, d_pixel_d_uv,
+                  d_pixel_d_params);
   } else if constexpr (std::is_same_v<CameraModel,
                                       colmap::PinholeCameraModel>) {
-    j::Distorted<0> d;
-    d.x = u;
-    d.y = v;
-    j::Project<2>(params, d, pixel, d_pixel_d_uv, d_pixel_d_params);
+    j::Project<2>(params, j::Undistorted(u, v), pixel, d_pixel_d_uv,
+                  d_pixel_d_params);
   } else if constexpr (std::is_same_v<CameraModel,
                                       colmap::SimpleRadialCameraModel>) {
     j::Project<1>(params, j::SimpleRadial(params + 3, u, v), pixel,
