@@ -18,6 +18,8 @@
 namespace rig_calibrator {
 namespace {
 
+constexpr double kMinCurvatureShare = 0.25;
+
 using Vector8d = Eigen::Matrix<double, 8, 1>;
 using Matrix5d = Eigen::Matrix<double, 5, 5>;
 using Vector5d = Eigen::Matrix<double, 5, 1>;
@@ -75,9 +77,16 @@ double RobustCost(const RadialPose& pose,
   return cost;
 }
 
-// Gauss-Newton normal equations (IRLS weights of the Cauchy loss) for the
-// update R <- exp([w]x) R, t <- t + dt. With Y = R X:
+// Normal equations for the update R <- exp([w]x) R, t <- t + dt of the cost
+// sum rho(e_i^2), rho(s) = c^2 log(1 + s / c^2). With Y = R X:
 //   d(a, b)/dw = [0, Y_3, -Y_2; -Y_3, 0, Y_1],  d(a, b)/dt = I.
+// Gradient: sum rho' e_i J_i^T (halved), rho' = 1 / (1 + u), u = e^2 / c^2.
+// Hessian: sum w_i J_i^T J_i with the loss' curvature in the weight,
+//   w = rho' + 2 rho'' e^2 = rho' (1 - u) / (1 + u),
+// kept at >= kMinCurvatureShare rho' (positive definite where the loss is
+// concave, u > 1). The IRLS weight rho' alone overstates the curvature of
+// points with u near 1 and makes convergence linear: at c = 1 px and 0.5 px
+// noise ~30 iterations to the last digits, against ~12.
 // Returns the robust cost at `pose`.
 double Linearize(const RadialPose& pose,
                  const std::vector<Eigen::Vector2d>& points2D,
@@ -93,12 +102,16 @@ double Linearize(const RadialPose& pose,
     const PointError e = ComputePointError(point_in_cam, points2D[i]);
     const double error_sq = e.error * e.error;
     cost += CauchyLoss(error_sq, scale_sq);
-    const double weight = 1 / (1 + error_sq / scale_sq);
+    const double u = error_sq / scale_sq;
+    const double rho1 = 1 / (1 + u);
+    const double curvature_weight =
+        rho1 * std::max((1 - u) / (1 + u), kMinCurvatureShare);
     Vector5d jacobian;
     jacobian << -e.d_b * rotated.z(), e.d_a * rotated.z(),
         e.d_b * rotated.x() - e.d_a * rotated.y(), e.d_a, e.d_b;
-    hessian->selfadjointView<Eigen::Upper>().rankUpdate(jacobian, weight);
-    *gradient += (weight * e.error) * jacobian;
+    hessian->selfadjointView<Eigen::Upper>().rankUpdate(jacobian,
+                                                        curvature_weight);
+    *gradient += (rho1 * e.error) * jacobian;
   }
   *hessian = hessian->selfadjointView<Eigen::Upper>();
   return cost;
@@ -106,10 +119,14 @@ double Linearize(const RadialPose& pose,
 
 // Levenberg-Marquardt over (rotation, tx, ty) minimizing the Cauchy cost
 // sum s^2 log(1 + e_i^2 / s^2) of the radial errors e_i, s = loss_scale.
+// Stops when an accepted step lowers the cost by less than
+// function_tolerance of it or moves less than 1e-12, or when a rejected
+// step raises it by no more than its rounding (1e-14 of it: no step can be
+// told from no step any more).
 void MinimizeCauchyRadialCost(const std::vector<Eigen::Vector2d>& points2D,
                               const std::vector<Eigen::Vector3d>& points3D,
                               double loss_scale, int max_num_iterations,
-                              RadialPose* pose) {
+                              double function_tolerance, RadialPose* pose) {
   const double scale_sq = loss_scale * loss_scale;
   Matrix5d hessian;
   Vector5d gradient;
@@ -134,11 +151,14 @@ void MinimizeCauchyRadialCost(const std::vector<Eigen::Vector2d>& points2D,
     if (candidate_cost < cost) {
       const double decrease = cost - candidate_cost;
       *pose = candidate;
-      if (decrease < 1e-14 * cost || step.norm() < 1e-12) return;
+      if (decrease < function_tolerance * cost || step.norm() < 1e-12) {
+        return;
+      }
       cost =
           Linearize(*pose, points2D, points3D, scale_sq, &hessian, &gradient);
       lambda = std::max(lambda * 0.1, 1e-12);
     } else {
+      if (candidate_cost - cost <= 1e-14 * cost) return;
       lambda *= 10;
       if (lambda > 1e8) return;
     }
@@ -277,7 +297,8 @@ std::vector<Rigid3d> RadialPoseLocalEstimator::Estimate(
   if (!(best_cost < std::numeric_limits<double>::infinity())) return {};
 
   MinimizeCauchyRadialCost(points2D, points3D_normalized_, loss_scale_px,
-                           max_num_iterations, &best_pose);
+                           max_num_iterations, function_tolerance,
+                           &best_pose);
 
   const Rigid3d cam_from_world =
       FromNormalizedFrame(best_pose, centroid, scale, 0);
@@ -327,9 +348,12 @@ bool RefineRadialPose(const RadialPoseEstimationOptions& options,
   if (!pose.rotation.allFinite() || !pose.translation.allFinite()) {
     return false;
   }
+  // The final estimate: to the last digits.
   constexpr int kMaxNumIterations = 50;
+  constexpr double kFunctionTolerance = 1e-14;
   MinimizeCauchyRadialCost(inlier_points2D, normalized_points3D,
-                           options.loss_scale_px, kMaxNumIterations, &pose);
+                           options.loss_scale_px, kMaxNumIterations,
+                           kFunctionTolerance, &pose);
   const Rigid3d refined = FromNormalizedFrame(pose, centroid, scale,
                                               cam_from_world->translation.z());
   if (!refined.rotation.coeffs().allFinite() ||
@@ -369,6 +393,7 @@ bool EstimateRadialPose(const RadialPoseEstimationOptions& options,
   ransac_options.min_num_trials = options.min_num_trials;
   ransac_options.max_num_trials = options.max_num_trials;
   ransac_options.min_inlier_ratio = options.min_inlier_ratio;
+  ransac_options.dyn_num_trials_multiplier = options.dyn_num_trials_multiplier;
   colmap::LORANSAC<RadialPoseEstimator, RadialPoseLocalEstimator,
                    colmap::MEstimatorSupportMeasurer>
       ransac(ransac_options);

@@ -67,6 +67,13 @@ class RadialPoseLocalEstimator {
   // the inlier threshold, so that inliers keep weights in [0.5, 1].
   double loss_scale_px = 8.0;
   int max_num_iterations = 15;
+  // Relative cost decrease at which the refinement stops. The local model
+  // only has to sort points around the inlier threshold (a 1e-6 relative
+  // change moves an inlier's error by ~1e-3 px); RefineRadialPose polishes
+  // the final estimate to 1e-14. At 1e-14 here nearly every local
+  // refinement ran all 15 iterations (the Cauchy loss' IRLS converges
+  // linearly at residuals near s).
+  double function_tolerance = 1e-6;
 
   std::vector<M_t> Estimate(const std::vector<X_t>& points2D,
                             const std::vector<Y_t>& points3D);
@@ -88,6 +95,13 @@ struct RadialPoseEstimationOptions {
   int min_num_trials = 30;
   int max_num_trials = 10000;
   double min_inlier_ratio = 0.1;
+  // Trials = multiplier * log(1 - confidence) / log(1 - w^5), w the best
+  // model's inlier ratio so far. COLMAP's default multiplier, 3, is a margin
+  // for a w estimated from an unrefined sample's inliers; here w comes from
+  // the locally optimized model, whose inlier set is the full one (within
+  // 1 % at 30 % outliers), so 1 is the bound the confidence states (0.9999:
+  // 50 trials at w = 0.7 instead of 150).
+  double dyn_num_trials_multiplier = 1.0;
   int min_num_inliers = 12;    // fewer: estimation fails
   double loss_scale_px = 1.0;  // Cauchy scale of the final refinement
   bool refine = true;          // final robust refinement on the inliers

@@ -338,6 +338,36 @@ TEST(EstimateRadialPose, NearPlanarNoiseAndOutliers) {
   ExpectAccurate(RunRobustEstimation(options, 20, 7), 0.5, 0.06);
 }
 
+// RANSAC stops at the trial count the confidence asks for at the found
+// inlier ratio w, log(1 - confidence) / log(1 - w^5), times
+// dyn_num_trials_multiplier (1 by default; COLMAP's 3 triples it). More
+// when the best model so far had fewer inliers than the final one.
+TEST(EstimateRadialPose, TrialsFollowTheConfidenceBound) {
+  std::mt19937 rng(11);
+  colmap::SetPRNGSeed(11);
+  for (int k = 0; k < 5; ++k) {
+    const Scene scene = MakeScene(NoisyScene(300, 0.5, 0.3), &rng);
+    for (const double multiplier : {1.0, 3.0}) {
+      RadialPoseEstimationOptions options;
+      options.dyn_num_trials_multiplier = multiplier;
+      RadialPoseEstimate estimate;
+      ASSERT_TRUE(EstimateRadialPose(options, scene.points2D, scene.points3D,
+                                     &estimate));
+      const double inlier_ratio =
+          static_cast<double>(estimate.num_inliers) / scene.points2D.size();
+      const double bound = std::log(1 - options.confidence) /
+                           std::log(1 - std::pow(inlier_ratio, 5));
+      EXPECT_GE(estimate.num_trials, options.min_num_trials);
+      EXPECT_LT(estimate.num_trials, 1.5 * multiplier * bound + 2)
+          << multiplier;
+      EXPECT_GT(estimate.num_trials, 0.9 * multiplier * bound - 2)
+          << multiplier;
+      EXPECT_LT(RotationErrorDeg(estimate.cam_from_world, scene.cam_from_world),
+                0.05);
+    }
+  }
+}
+
 TEST(EstimateRadialPose, ExactDataWithOutliers) {
   std::mt19937 rng(8);
   colmap::SetPRNGSeed(8);
