@@ -295,7 +295,7 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
   const int num_unknowns = 1 + refined.num_tangent_params;
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.max_num_iterations;
   solver_options.num_threads =
       colmap::GetEffectiveNumThreads(options.num_threads);

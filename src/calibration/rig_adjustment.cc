@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "src/geometry/rig_reprojection_cost.h"
+
 namespace rig_calibrator {
 
 PoseParams ToPoseParams(const Rigid3d& pose) {
@@ -23,9 +25,7 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
       dataset_(dataset),
       cameras_(calibration.cameras),
       loss_(std::make_unique<ceres::CauchyLoss>(options.loss_scale_px)),
-      pose_manifold_(
-          std::make_unique<ceres::ProductManifold<
-              ceres::QuaternionManifold, ceres::EuclideanManifold<3>>>()) {
+      pose_manifold_(std::make_unique<RigPoseManifold>()) {
   for (const Rigid3d& pose : calibration.cam_from_rig) {
     cam_from_rig_.push_back(ToPoseParams(pose));
   }

@@ -20,6 +20,12 @@
 //   dr/dt_Q = dr/dp R_P,                dr/dq_Q = dr/dp R_P dR(q_Q) X / dq_Q,
 //   dr/dX   = dr/dp R_P R_Q,
 // with y = R_Q X + t_Q and dR(q) p / dq from RotatedPointQuaternionJacobian.
+// In the tangent space of RigPoseManifold (EvaluateTangent: the final
+// bundle adjustment's solver), q' = [cos|d|, sin|d| d / |d|] q, so
+// R(q') = (I + 2 [d]x) R(q) to first order and, with the rotated parts
+// a_P = R_P y, a_Q = R_Q X,
+//   dr/d(d_P, t_P) = dr/dp [-2 [a_P]x, I],
+//   dr/d(d_Q, t_Q) = dr/dp R_P [-2 [a_Q]x, I].
 // pi_theta and its derivatives come from camera_model_jacobians.h (closed
 // form for the common models): the Jacobian evaluation dominates the final
 // bundle adjustment.
@@ -28,14 +34,21 @@
 #pragma once
 
 #include <ceres/cost_function.h>
+#include <ceres/manifold.h>
 #include <colmap/base/pose.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "src/geometry/camera_model_jacobians.h"
+#include "src/geometry/tangent_jacobian_cost.h"
 
 namespace rig_calibrator {
+
+// The manifold of a pose block [qw, qx, qy, qz, tx, ty, tz]: Ceres'
+// quaternion (left-multiplied update) times R^3; tangent (d, t).
+using RigPoseManifold = ceres::ProductManifold<ceres::QuaternionManifold,
+                                               ceres::EuclideanManifold<3>>;
 
 // d(R(q) p)/dq for a unit quaternion q = (w, v), as a 3 x 4 matrix over
 // (w, v_x, v_y, v_z): from
@@ -58,7 +71,7 @@ inline Eigen::Matrix<double, 3, 4> RotatedPointQuaternionJacobian(
 // r = pi_theta(P Q X) - x for the COLMAP model CameraModel (see the top of
 // the file); X is a fixed point given at construction or the fourth block.
 template <typename CameraModel>
-class RigReprojectionCost final : public ceres::CostFunction {
+class RigReprojectionCost final : public TangentJacobianCost {
  public:
   static constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
 
@@ -77,6 +90,46 @@ class RigReprojectionCost final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    return EvaluateImpl</*kTangent=*/false>(parameters, residuals, jacobians);
+  }
+  // The poses' Jacobians 2 x 6 in RigPoseManifold's tangent space.
+  int TangentSize(int parameter_block) const override {
+    return parameter_block < 2 ? 6 : 0;
+  }
+  bool EvaluateTangent(double const* const* parameters, double* residuals,
+                       double** jacobians) const override {
+    return EvaluateImpl</*kTangent=*/true>(parameters, residuals, jacobians);
+  }
+
+ private:
+  // The pose Jacobian [dr/d(rotation), dr/dt] for the point's rotated part
+  // `rotated` = R p of that pose and dr/d(R p + t) = d_pixel: ambient over
+  // (q, t) or, kTangent, over RigPoseManifold's (d, t).
+  template <bool kTangent>
+  static void WritePoseJacobian(const Eigen::Matrix<double, 2, 3>& d_pixel,
+                                const Eigen::Quaterniond& rotation,
+                                const Eigen::Vector3d& unrotated,
+                                const Eigen::Vector3d& rotated,
+                                double* jacobian) {
+    if constexpr (kTangent) {
+      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> out(jacobian);
+      // g (-2 [a]x) = 2 (a x g^T)^T for a row g.
+      for (int row = 0; row < 2; ++row) {
+        const Eigen::Vector3d g = d_pixel.row(row).transpose();
+        out.template block<1, 3>(row, 0) = 2 * rotated.cross(g).transpose();
+      }
+      out.template rightCols<3>() = d_pixel;
+    } else {
+      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> out(jacobian);
+      out.template leftCols<4>() =
+          d_pixel * RotatedPointQuaternionJacobian(rotation, unrotated);
+      out.template rightCols<3>() = d_pixel;
+    }
+  }
+
+  template <bool kTangent>
+  bool EvaluateImpl(double const* const* parameters, double* residuals,
+                    double** jacobians) const {
     const double* rig_from_world = parameters[0];
     const double* cam_from_rig = parameters[1];
     const double* camera_params = parameters[2];
@@ -88,10 +141,12 @@ class RigReprojectionCost final : public ceres::CostFunction {
     const Eigen::Matrix3d cam_rotation_matrix = cam_rotation.toRotationMatrix();
     const Eigen::Vector3d point3D =
         variable_point_ ? Eigen::Vector3d(parameters[3]) : fixed_point3D_;
+    const Eigen::Vector3d rig_rotated = rig_rotation_matrix * point3D;
     const Eigen::Vector3d point_in_rig =
-        rig_rotation_matrix * point3D + Eigen::Vector3d(rig_from_world + 4);
+        rig_rotated + Eigen::Vector3d(rig_from_world + 4);
+    const Eigen::Vector3d cam_rotated = cam_rotation_matrix * point_in_rig;
     const Eigen::Vector3d point_in_cam =
-        cam_rotation_matrix * point_in_rig + Eigen::Vector3d(cam_from_rig + 4);
+        cam_rotated + Eigen::Vector3d(cam_from_rig + 4);
     const double z = point_in_cam.z();
     if (!(z > 0)) {
       return false;
@@ -117,20 +172,15 @@ class RigReprojectionCost final : public ceres::CostFunction {
     d_pixel_d_cam.col(1) = d_pixel_d_uv.col(1) / z;
     d_pixel_d_cam.col(2) =
         -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
-    using PoseJacobian = Eigen::Matrix<double, 2, 7, Eigen::RowMajor>;
     if (jacobians[1] != nullptr) {
-      Eigen::Map<PoseJacobian> jacobian(jacobians[1]);
-      jacobian.leftCols<4>() = d_pixel_d_cam * RotatedPointQuaternionJacobian(
-                                                   cam_rotation, point_in_rig);
-      jacobian.rightCols<3>() = d_pixel_d_cam;
+      WritePoseJacobian<kTangent>(d_pixel_d_cam, cam_rotation, point_in_rig,
+                                  cam_rotated, jacobians[1]);
     }
     const Eigen::Matrix<double, 2, 3> d_pixel_d_rig =
         d_pixel_d_cam * cam_rotation_matrix;
     if (jacobians[0] != nullptr) {
-      Eigen::Map<PoseJacobian> jacobian(jacobians[0]);
-      jacobian.leftCols<4>() =
-          d_pixel_d_rig * RotatedPointQuaternionJacobian(rig_rotation, point3D);
-      jacobian.rightCols<3>() = d_pixel_d_rig;
+      WritePoseJacobian<kTangent>(d_pixel_d_rig, rig_rotation, point3D,
+                                  rig_rotated, jacobians[0]);
     }
     if (variable_point_ && jacobians[3] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(
@@ -140,7 +190,6 @@ class RigReprojectionCost final : public ceres::CostFunction {
     return true;
   }
 
- private:
   const Eigen::Vector2d observed_;
   const Eigen::Vector3d fixed_point3D_;
   const bool variable_point_;

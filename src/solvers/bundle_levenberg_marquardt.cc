@@ -146,6 +146,11 @@ struct BundleLevenbergMarquardt::Impl {
   };
   struct Residual {
     const ceres::CostFunction* cost = nullptr;
+    // Non-null: evaluated by EvaluateTangent, with jacobian_columns[k] the
+    // columns of block k's Jacobian (its tangent size where tangent[k]).
+    const TangentJacobianCost* tangent_cost = nullptr;
+    std::array<int, kMaxParametersPerResidual> jacobian_columns{};
+    std::array<bool, kMaxParametersPerResidual> tangent{};
     const ceres::LossFunction* loss = nullptr;
     std::array<double*, kMaxParametersPerResidual> parameters{};
     std::array<int, kMaxParametersPerResidual> block{};  // -1: constant
@@ -636,28 +641,28 @@ bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
   if (linearize) {
     size_t size = 0;
     for (int k = 0; k < residual.num_parameters; ++k) {
-      if (residual.block[k] >= 0) {
-        size += 2 * blocks[residual.block[k]].size;
-      } else if (k == residual.point_parameter) {
-        size += 6;
+      if (residual.block[k] >= 0 || k == residual.point_parameter) {
+        size += 2 * residual.jacobian_columns[k];
       }
     }
     if (scratch->size() < size) scratch->resize(size);
     size = 0;
     for (int k = 0; k < residual.num_parameters; ++k) {
-      if (residual.block[k] >= 0) {
+      if (residual.block[k] >= 0 || k == residual.point_parameter) {
         ambient[k] = scratch->data() + size;
-        size += 2 * blocks[residual.block[k]].size;
-      } else if (k == residual.point_parameter) {
-        ambient[k] = scratch->data() + size;
-        size += 6;
+        size += 2 * residual.jacobian_columns[k];
       }
     }
   }
   double r[2];
-  if (!residual.cost->Evaluate(residual.parameters.data(), r,
-                               linearize ? ambient.data() : nullptr) ||
-      !std::isfinite(r[0]) || !std::isfinite(r[1])) {
+  const bool evaluated =
+      residual.tangent_cost != nullptr
+          ? residual.tangent_cost->EvaluateTangent(
+                residual.parameters.data(), r,
+                linearize ? ambient.data() : nullptr)
+          : residual.cost->Evaluate(residual.parameters.data(), r,
+                                    linearize ? ambient.data() : nullptr);
+  if (!evaluated || !std::isfinite(r[0]) || !std::isfinite(r[1])) {
     return false;
   }
   const double sq_norm = r[0] * r[0] + r[1] * r[1];
@@ -687,7 +692,8 @@ bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
       jacobian[cols + c] = sqrt_rho1 * (j1 - alpha_sq_norm * r[1] * rtj);
     }
   };
-  // Tangent Jacobians, by group: J_ambient (2 x size) * plus Jacobian.
+  // Tangent Jacobians, by group: the cost's, or J_ambient (2 x size) * plus
+  // Jacobian.
   for (int g = 0; g < residual.num_groups; ++g) {
     const int group = residual.groups[g];
     double* out = jacobian_base + residual.group_jacobian[g];
@@ -697,10 +703,11 @@ bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
       const int b = residual.block[k];
       if (b < 0 || blocks[b].group != group) continue;
       const Block& block = blocks[b];
-      if (block.manifold == nullptr) {
-        for (int i = 0; i < block.size; ++i) {
+      if (block.manifold == nullptr || residual.tangent[k]) {
+        for (int i = 0; i < block.tangent_size; ++i) {
           out[block.column + i] = ambient[k][i];
-          out[group_size + block.column + i] = ambient[k][block.size + i];
+          out[group_size + block.column + i] =
+              ambient[k][block.tangent_size + i];
         }
       } else {
         AddAB(ambient[k], plus_jacobians.data() + plus_jacobian_offset[b], 2,
@@ -1100,6 +1107,7 @@ size_t BundleLevenbergMarquardt::AddResidualBlock(
       cached = {parameters[k],
                 block != impl_->block_index.end() ? block->second : -1};
     }
+    residual.jacobian_columns[k] = cost->parameter_block_sizes()[k];
     if (cached.second >= 0) {
       CHECK_EQ(impl_->blocks[cached.second].size,
                cost->parameter_block_sizes()[k]);
@@ -1112,6 +1120,27 @@ size_t BundleLevenbergMarquardt::AddResidualBlock(
       CHECK_LT(residual.point, 0) << "two points in one residual block";
       residual.point = point->second;
       residual.point_parameter = k;
+    }
+  }
+  // Tangent Jacobians from the cost if every refined block it gives them for
+  // is on a manifold of that tangent size.
+  const auto* tangent_cost = dynamic_cast<const TangentJacobianCost*>(cost);
+  bool use_tangent = tangent_cost != nullptr;
+  for (int k = 0; use_tangent && k < residual.num_parameters; ++k) {
+    const int tangent_size = tangent_cost->TangentSize(k);
+    if (tangent_size <= 0 || residual.block[k] < 0) continue;
+    const Impl::Block& block = impl_->blocks[residual.block[k]];
+    use_tangent =
+        block.manifold != nullptr && block.tangent_size == tangent_size;
+  }
+  if (use_tangent) {
+    residual.tangent_cost = tangent_cost;
+    for (int k = 0; k < residual.num_parameters; ++k) {
+      residual.tangent[k] =
+          tangent_cost->TangentSize(k) > 0 && residual.block[k] >= 0;
+      if (residual.tangent[k]) {
+        residual.jacobian_columns[k] = tangent_cost->TangentSize(k);
+      }
     }
   }
   impl_->residuals.push_back(std::move(residual));

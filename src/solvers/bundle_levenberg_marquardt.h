@@ -11,7 +11,9 @@
 //
 // Parameter blocks live on manifolds (ceres::Manifold: quaternion x R^3 for
 // poses, a subset manifold for partly held intrinsics); steps are taken in
-// their tangent spaces, x' = Plus(x, delta). Camera-side blocks are put in
+// their tangent spaces, x' = Plus(x, delta). The tangent Jacobian of a block
+// is the cost's ambient one times the manifold's PlusJacobian, or comes from
+// the cost directly (TangentJacobianCost). Camera-side blocks are put in
 // groups (e.g. a camera's cam_from_rig and intrinsics): a group is one block
 // row of the reduced system, so that an observation touches two of them
 // instead of three.
@@ -55,6 +57,8 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "src/geometry/tangent_jacobian_cost.h"
 
 namespace rig_calibrator {
 
@@ -108,10 +112,11 @@ class BundleLevenbergMarquardt {
   // A point (3 values, Euclidean), eliminated in the reduced system.
   void AddPoint(double* values);
   // A residual block of 2 rows: `cost` over `parameters` (the pointers its
-  // Evaluate takes, in its order). A pointer that was added as a parameter
-  // block or a point is refined, any other is held constant. `loss` null:
-  // least squares. Neither is owned. Returns its index, from 0 in the order
-  // of addition.
+  // Evaluate takes, in its order; the parameter blocks added before). A
+  // TangentJacobianCost is evaluated by EvaluateTangent where it can be. A
+  // pointer that was added as a parameter block or a point is refined, any
+  // other is held constant. `loss` null: least squares. Neither is owned.
+  // Returns its index, from 0 in the order of addition.
   size_t AddResidualBlock(const ceres::CostFunction* cost,
                           const ceres::LossFunction* loss,
                           const std::vector<double*>& parameters);

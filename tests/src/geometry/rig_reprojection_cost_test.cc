@@ -132,6 +132,47 @@ void ExpectJacobiansMatchAutoDiff() {
     if (variable_point) {
       EXPECT_LT((point_jacobian - expected_point).norm(), scale);
     }
+    // In RigPoseManifold's tangent space (the solver's EvaluateTangent): the
+    // same residual, the poses' 2 x 6 Jacobians equal to the auto-
+    // differentiated ones times the manifold's PlusJacobian, the rest
+    // ambient.
+    const auto* tangent_cost =
+        dynamic_cast<const TangentJacobianCost*>(cost.get());
+    ASSERT_NE(tangent_cost, nullptr);
+    const RigPoseManifold pose_manifold;
+    EXPECT_EQ(tangent_cost->TangentSize(0), pose_manifold.TangentSize());
+    EXPECT_EQ(tangent_cost->TangentSize(1), pose_manifold.TangentSize());
+    EXPECT_EQ(tangent_cost->TangentSize(2), 0);
+    const auto tangent_of =
+        [&](const std::array<double, 7>& block,
+            const Eigen::Matrix<double, 2, 7, Eigen::RowMajor>& jacobian) {
+          Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus_jacobian;
+          pose_manifold.PlusJacobian(block.data(), plus_jacobian.data());
+          return Eigen::Matrix<double, 2, 6>(jacobian * plus_jacobian);
+        };
+    Eigen::Vector2d tangent_residual;
+    Eigen::Matrix<double, 2, 6, Eigen::RowMajor> rig_tangent, cam_tangent;
+    params_jacobian.setZero();
+    point_jacobian.setZero();
+    double* tangent_jacobians[] = {rig_tangent.data(), cam_tangent.data(),
+                                   params_jacobian.data(),
+                                   point_jacobian.data()};
+    ASSERT_TRUE(tangent_cost->EvaluateTangent(
+        parameters, tangent_residual.data(), tangent_jacobians));
+    EXPECT_LT((tangent_residual - expected_residual).norm(), 1e-10);
+    EXPECT_LT((Eigen::Matrix<double, 2, 6>(rig_tangent) -
+               tangent_of(rig_block, expected_rig))
+                  .norm(),
+              scale);
+    EXPECT_LT((Eigen::Matrix<double, 2, 6>(cam_tangent) -
+               tangent_of(cam_block, expected_cam))
+                  .norm(),
+              scale);
+    EXPECT_LT((params_jacobian - expected_params).norm(),
+              1e-10 * expected_params.norm());
+    if (variable_point) {
+      EXPECT_LT((point_jacobian - expected_point).norm(), scale);
+    }
     // Without the intrinsics' Jacobian (constant block) the rest is the same.
     jacobians[2] = nullptr;
     ASSERT_TRUE(cost->Evaluate(parameters, residual.data(), jacobians));

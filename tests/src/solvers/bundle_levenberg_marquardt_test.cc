@@ -154,12 +154,31 @@ struct Problem {
   ceres::SubsetManifold principal_point_held{4, {1, 2}};
 };
 
-void BuildProblem(Scene* scene, Problem* problem) {
+// A cost's Evaluate only: hides TangentJacobianCost from the solver, which
+// then multiplies ambient Jacobians by PlusJacobians.
+class AmbientOnlyCost final : public ceres::CostFunction {
+ public:
+  explicit AmbientOnlyCost(ceres::CostFunction* cost) : cost_(cost) {
+    set_num_residuals(cost->num_residuals());
+    *mutable_parameter_block_sizes() = cost->parameter_block_sizes();
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return cost_->Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> cost_;
+};
+
+void BuildProblem(Scene* scene, Problem* problem, bool ambient_only = false) {
   for (const Scene::Observation& observation : scene->observations) {
     const bool fixed = observation.point < Scene::kNumFixedPoints;
-    problem->costs.emplace_back(CreateRigReprojectionCost(
+    ceres::CostFunction* cost = CreateRigReprojectionCost(
         colmap::SimpleRadialCameraModel::kModelId, observation.pixel,
-        fixed ? &scene->points[observation.point] : nullptr));
+        fixed ? &scene->points[observation.point] : nullptr);
+    problem->costs.emplace_back(ambient_only ? new AmbientOnlyCost(cost)
+                                             : cost);
     std::vector<double*> parameters = {
         scene->rig_from_world[observation.frameset].data(),
         scene->cam_from_rig[observation.camera].data(),
@@ -170,9 +189,10 @@ void BuildProblem(Scene* scene, Problem* problem) {
 }
 
 void SolveOurs(const ceres::LossFunction* loss, int num_threads, Scene* scene,
-               BundleLevenbergMarquardtSummary* summary) {
+               BundleLevenbergMarquardtSummary* summary,
+               bool ambient_only = false) {
   Problem problem;
-  BuildProblem(scene, &problem);
+  BuildProblem(scene, &problem, ambient_only);
   BundleLevenbergMarquardtOptions options;
   options.parameter_tolerance = 1e-12;
   options.function_tolerance = 1e-12;
@@ -318,6 +338,31 @@ TEST(BundleLevenbergMarquardtTest, RobustSolveMatchesCeresAndIsAccurate) {
   EXPECT_LT(errors.translation, 5e-3);
   EXPECT_LT(errors.focal_relative, 2e-3);
   EXPECT_LT(errors.extra, 5e-3);
+}
+
+// The costs' own tangent Jacobians (RigReprojectionCost::EvaluateTangent)
+// and the ambient ones times the manifolds' PlusJacobians: the same solve.
+TEST(BundleLevenbergMarquardtTest, TangentJacobiansGiveTheAmbientPathsSolve) {
+  const Scene truth = MakeScene(0.5, 0.1, 12);
+  const Scene start = Perturbed(truth, 13);
+  ceres::CauchyLoss loss(1.0);
+  Scene tangent = start, ambient = start;
+  BundleLevenbergMarquardtSummary tangent_summary, ambient_summary;
+  SolveOurs(&loss, 2, &tangent, &tangent_summary);
+  SolveOurs(&loss, 2, &ambient, &ambient_summary, /*ambient_only=*/true);
+  ASSERT_TRUE(tangent_summary.IsSolutionUsable());
+  ASSERT_TRUE(ambient_summary.IsSolutionUsable());
+  EXPECT_NEAR(tangent_summary.initial_cost, ambient_summary.initial_cost,
+              1e-12 * ambient_summary.initial_cost);
+  EXPECT_NEAR(tangent_summary.final_cost, ambient_summary.final_cost,
+              1e-10 * ambient_summary.final_cost);
+  EXPECT_EQ(tangent_summary.num_successful_steps,
+            ambient_summary.num_successful_steps);
+  const Errors between = Compare(tangent, ambient);
+  EXPECT_LT(between.rotation_rad, 1e-9);
+  EXPECT_LT(between.translation, 1e-9);
+  EXPECT_LT(between.point, 1e-8);
+  EXPECT_LT(between.focal_relative, 1e-10);
 }
 
 TEST(BundleLevenbergMarquardtTest, ResultDoesNotDependOnThreadCount) {
