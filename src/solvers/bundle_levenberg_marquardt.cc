@@ -264,9 +264,18 @@ struct BundleLevenbergMarquardt::Impl {
   std::vector<double> point_v_inverse;  // (V_p + D_p / mu)^-1
   std::vector<double> point_step;
   Eigen::VectorXd camera_step;
-  // Per chunk: its copy of the reduced system and right-hand side.
-  std::vector<std::vector<double>> chunk_pairs;
+  // Per chunk: its copy of the reduced system and right-hand side. A copy
+  // is written, zeroed and summed only over the pair values its chunk's
+  // terms reach (intervals of offsets, merged): a chunk of consecutive
+  // points or images reaches a few rig poses' rows and the cameras', a small
+  // part of the whole (500 framesets x 10 cameras: 16 full copies were
+  // ~130 MB to zero and add at every step).
+  using Intervals = std::vector<std::pair<size_t, size_t>>;
+  std::vector<UninitializedArray> chunk_pairs;
   std::vector<std::vector<double>> chunk_vectors;
+  std::vector<Intervals> point_chunk_intervals, batch_chunk_intervals;
+  // Their union over all chunks, for the sums.
+  Intervals IntervalsOfPairs(std::vector<int> pairs) const;
 
   int NumThreads() const {
     return options.num_threads > 0
@@ -599,8 +608,23 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
     batch_chunks.emplace_back(first_batch, end);
     first_batch = end;
   }
-  chunk_pairs.assign(std::max(chunks.size(), batch_chunks.size()),
-                     std::vector<double>(pair_values_size, 0));
+  chunk_pairs.resize(std::max(chunks.size(), batch_chunks.size()));
+  for (UninitializedArray& copy : chunk_pairs) copy.Resize(pair_values_size);
+  point_chunk_intervals.clear();
+  for (const Chunk& chunk : chunks) {
+    point_chunk_intervals.push_back(IntervalsOfPairs(std::vector<int>(
+        point_pairs.begin() + point_pairs_begin[chunk.first_point],
+        point_pairs.begin() + point_pairs_begin[chunk.end_point])));
+  }
+  batch_chunk_intervals.clear();
+  for (const auto& [first_batch, end_batch] : batch_chunks) {
+    std::vector<int> pairs;
+    for (size_t b = first_batch; b < end_batch; ++b) {
+      pairs.insert(pairs.end(), batches[b].pairs.begin(),
+                   batches[b].pairs.end());
+    }
+    batch_chunk_intervals.push_back(IntervalsOfPairs(std::move(pairs)));
+  }
   chunk_vectors.assign(chunk_pairs.size(),
                        std::vector<double>(reduced_size, 0));
 
@@ -616,6 +640,27 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   point_step.assign(3 * num_points, 0);
   camera_step = Eigen::VectorXd::Zero(reduced_size);
   return true;
+}
+
+BundleLevenbergMarquardt::Impl::Intervals
+BundleLevenbergMarquardt::Impl::IntervalsOfPairs(std::vector<int> pairs) const {
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  Intervals intervals;
+  for (const int pair : pairs) {
+    const PairBlock& block = pair_blocks[pair];
+    const size_t begin = block.offset;
+    const size_t end =
+        begin + static_cast<size_t>(groups[block.row_group].size) *
+                    groups[block.col_group].size;
+    // Pair blocks lie in index order, so sorted pairs give sorted offsets.
+    if (!intervals.empty() && intervals.back().second == begin) {
+      intervals.back().second = end;
+    } else {
+      intervals.emplace_back(begin, end);
+    }
+  }
+  return intervals;
 }
 
 bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
@@ -820,9 +865,11 @@ void BundleLevenbergMarquardt::Impl::AccumulateU() {
   const int num_chunks = static_cast<int>(batch_chunks.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
   for (int c = 0; c < num_chunks; ++c) {
-    std::vector<double>& pairs = chunk_pairs[c];
+    double* pairs = chunk_pairs[c].data();
     std::vector<double>& vector = chunk_vectors[c];
-    std::fill(pairs.begin(), pairs.end(), 0);
+    for (const auto& [begin, end] : batch_chunk_intervals[c]) {
+      std::fill(pairs + begin, pairs + end, 0.0);
+    }
     std::fill(vector.begin(), vector.end(), 0);
     for (size_t b = batch_chunks[c].first; b < batch_chunks[c].second; ++b) {
       const Batch& batch = batches[b];
@@ -859,7 +906,10 @@ void BundleLevenbergMarquardt::Impl::AccumulateU() {
   std::fill(u_raw.begin(), u_raw.end(), 0);
   std::fill(b_camera.begin(), b_camera.end(), 0);
   for (int c = 0; c < num_chunks; ++c) {
-    for (size_t k = 0; k < pair_values_size; ++k) u_raw[k] += chunk_pairs[c][k];
+    const double* pairs = chunk_pairs[c].data();
+    for (const auto& [begin, end] : batch_chunk_intervals[c]) {
+      for (size_t k = begin; k < end; ++k) u_raw[k] += pairs[k];
+    }
     for (int k = 0; k < reduced_size; ++k) b_camera[k] += chunk_vectors[c][k];
   }
 }
@@ -872,9 +922,11 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
 #pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
   for (int c = 0; c < num_chunks; ++c) {
     const Chunk& chunk = chunks[c];
-    std::vector<double>& pairs = chunk_pairs[c];
+    double* pairs = chunk_pairs[c].data();
     std::vector<double>& vector = chunk_vectors[c];
-    std::fill(pairs.begin(), pairs.end(), 0);
+    for (const auto& [begin, end] : point_chunk_intervals[c]) {
+      std::fill(pairs + begin, pairs + end, 0.0);
+    }
     std::fill(vector.begin(), vector.end(), 0);
     std::vector<double> y;  // V~^-1 W_pg, 3 x group size, per group
     std::vector<size_t> y_offset;
@@ -928,7 +980,10 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
   Eigen::VectorXd rhs =
       -Eigen::Map<const Eigen::VectorXd>(b_camera.data(), reduced_size);
   for (int c = 0; c < num_chunks; ++c) {
-    for (size_t k = 0; k < pair_values_size; ++k) s[k] += chunk_pairs[c][k];
+    const double* pairs = chunk_pairs[c].data();
+    for (const auto& [begin, end] : point_chunk_intervals[c]) {
+      for (size_t k = begin; k < end; ++k) s[k] += pairs[k];
+    }
     for (int k = 0; k < reduced_size; ++k) rhs[k] += chunk_vectors[c][k];
   }
   for (size_t g = 0; g < groups.size(); ++g) {
