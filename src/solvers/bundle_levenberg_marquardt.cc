@@ -40,9 +40,73 @@ using ConstRowMajorMap =
 // The small dense products of the loops below, on row-major blocks with
 // run-time sizes (a group has 6 to ~20 columns), written out: Eigen's
 // dynamic-size products allocate temporaries and take its large-matrix path.
+// The common shapes (k = 2 or 3 rows: an observation's or a point's; up to
+// kMaxFixedColumns columns) run as instances with compile-time sizes, whose
+// inner loops the compiler unrolls and vectorizes; the order of the
+// additions into each element is the same, so the results are too.
+constexpr int kMaxFixedColumns = 16;
+
 // c (m x n, row stride ldc) += sign * a^T b, a: k x m, b: k x n.
+template <int K, int N>
+void AddATransposeBFixed(const double* a, const double* b, int m, double sign,
+                         double* c, int ldc) {
+  for (int i = 0; i < m; ++i) {
+    double* row = c + i * ldc;
+    for (int l = 0; l < K; ++l) {
+      const double factor = sign * a[l * m + i];
+      const double* b_row = b + l * N;
+      for (int j = 0; j < N; ++j) row[j] += factor * b_row[j];
+    }
+  }
+}
+// c (m x n, row stride ldc) += a b, a: m x k, b: k x n.
+template <int K, int N>
+void AddABFixed(const double* a, const double* b, int m, double* c, int ldc) {
+  for (int i = 0; i < m; ++i) {
+    double* row = c + i * ldc;
+    for (int l = 0; l < K; ++l) {
+      const double factor = a[i * K + l];
+      const double* b_row = b + l * N;
+      for (int j = 0; j < N; ++j) row[j] += factor * b_row[j];
+    }
+  }
+}
+
+// The instance of Kernel<K, N> for run-time (k, n), or false.
+template <template <int, int> class Kernel, int N = 1>
+struct FixedDispatch {
+  template <typename... Args>
+  static bool Run(int k, int n, Args... args) {
+    if (n == N) {
+      if (k == 2) return Kernel<2, N>::Run(args...), true;
+      if (k == 3) return Kernel<3, N>::Run(args...), true;
+      return false;
+    }
+    if constexpr (N < kMaxFixedColumns) {
+      return FixedDispatch<Kernel, N + 1>::Run(k, n, args...);
+    }
+    return false;
+  }
+};
+template <int K, int N>
+struct AddATransposeBKernel {
+  static void Run(const double* a, const double* b, int m, double sign,
+                  double* c, int ldc) {
+    AddATransposeBFixed<K, N>(a, b, m, sign, c, ldc);
+  }
+};
+template <int K, int N>
+struct AddABKernel {
+  static void Run(const double* a, const double* b, int m, double* c, int ldc) {
+    AddABFixed<K, N>(a, b, m, c, ldc);
+  }
+};
+
 inline void AddATransposeB(const double* a, const double* b, int k, int m,
                            int n, double sign, double* c, int ldc) {
+  if (FixedDispatch<AddATransposeBKernel>::Run(k, n, a, b, m, sign, c, ldc)) {
+    return;
+  }
   for (int i = 0; i < m; ++i) {
     double* row = c + i * ldc;
     for (int l = 0; l < k; ++l) {
@@ -64,9 +128,9 @@ inline void AddATransposeBUpper(const double* a, const double* b, int k, int m,
     }
   }
 }
-// c (m x n, row stride ldc) += a b, a: m x k, b: k x n.
 inline void AddAB(const double* a, const double* b, int m, int k, int n,
                   double* c, int ldc) {
+  if (FixedDispatch<AddABKernel>::Run(k, n, a, b, m, c, ldc)) return;
   for (int i = 0; i < m; ++i) {
     double* row = c + i * ldc;
     for (int l = 0; l < k; ++l) {
@@ -274,8 +338,14 @@ struct BundleLevenbergMarquardt::Impl {
   std::vector<UninitializedArray> chunk_pairs;
   std::vector<std::vector<double>> chunk_vectors;
   std::vector<Intervals> point_chunk_intervals, batch_chunk_intervals;
-  // Their union over all chunks, for the sums.
   Intervals IntervalsOfPairs(std::vector<int> pairs) const;
+  // out = base (null: 0) + the first num_chunks copies, each over its
+  // intervals, added in chunk order; in parallel over ranges of values (the
+  // order of the additions into each value does not depend on the threads).
+  void SumChunkCopies(const double* base,
+                      const std::vector<Intervals>& intervals, int num_chunks,
+                      double* out) const;
+  std::vector<double> reduced_values;  // S, pair values, at each step
 
   int NumThreads() const {
     return options.num_threads > 0
@@ -610,6 +680,7 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   }
   chunk_pairs.resize(std::max(chunks.size(), batch_chunks.size()));
   for (UninitializedArray& copy : chunk_pairs) copy.Resize(pair_values_size);
+  reduced_values.assign(pair_values_size, 0);
   point_chunk_intervals.clear();
   for (const Chunk& chunk : chunks) {
     point_chunk_intervals.push_back(IntervalsOfPairs(std::vector<int>(
@@ -903,14 +974,33 @@ void BundleLevenbergMarquardt::Impl::AccumulateU() {
       }
     }
   }
-  std::fill(u_raw.begin(), u_raw.end(), 0);
+  SumChunkCopies(nullptr, batch_chunk_intervals, num_chunks, u_raw.data());
   std::fill(b_camera.begin(), b_camera.end(), 0);
   for (int c = 0; c < num_chunks; ++c) {
-    const double* pairs = chunk_pairs[c].data();
-    for (const auto& [begin, end] : batch_chunk_intervals[c]) {
-      for (size_t k = begin; k < end; ++k) u_raw[k] += pairs[k];
-    }
     for (int k = 0; k < reduced_size; ++k) b_camera[k] += chunk_vectors[c][k];
+  }
+}
+
+void BundleLevenbergMarquardt::Impl::SumChunkCopies(
+    const double* base, const std::vector<Intervals>& intervals, int num_chunks,
+    double* out) const {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+  for (int r = 0; r < kMaxNumChunks; ++r) {
+    const size_t range_begin = pair_values_size * r / kMaxNumChunks;
+    const size_t range_end = pair_values_size * (r + 1) / kMaxNumChunks;
+    if (base != nullptr) {
+      std::copy(base + range_begin, base + range_end, out + range_begin);
+    } else {
+      std::fill(out + range_begin, out + range_end, 0.0);
+    }
+    for (int c = 0; c < num_chunks; ++c) {
+      const double* copy = chunk_pairs[c].data();
+      for (const auto& [begin, end] : intervals[c]) {
+        const size_t first = std::max(begin, range_begin);
+        const size_t last = std::min(end, range_end);
+        for (size_t k = first; k < last; ++k) out[k] += copy[k];
+      }
+    }
   }
 }
 
@@ -976,14 +1066,11 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
     }
   }
   // S = U + D / mu + the chunks' parts; rhs = -b_c + theirs; chunk order.
-  std::vector<double> s = u_raw;
+  std::vector<double>& s = reduced_values;
+  SumChunkCopies(u_raw.data(), point_chunk_intervals, num_chunks, s.data());
   Eigen::VectorXd rhs =
       -Eigen::Map<const Eigen::VectorXd>(b_camera.data(), reduced_size);
   for (int c = 0; c < num_chunks; ++c) {
-    const double* pairs = chunk_pairs[c].data();
-    for (const auto& [begin, end] : point_chunk_intervals[c]) {
-      for (size_t k = begin; k < end; ++k) s[k] += pairs[k];
-    }
     for (int k = 0; k < reduced_size; ++k) rhs[k] += chunk_vectors[c][k];
   }
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -994,7 +1081,9 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
     }
   }
   double* values = reduced.valuePtr();
-  for (size_t k = 0; k < reduced_value_source.size(); ++k) {
+  const int64_t num_values = static_cast<int64_t>(reduced_value_source.size());
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
+  for (int64_t k = 0; k < num_values; ++k) {
     values[k] = s[reduced_value_source[k]];
   }
   *schur_seconds += Seconds(schur_start);
