@@ -1,5 +1,7 @@
 #include "src/calibration/rig_adjustment.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -157,10 +159,23 @@ double RigAdjustment::MapRmsError() {
   return in_problem.empty() ? 0 : std::sqrt(sum / in_problem.size());
 }
 
+std::vector<RigAdjustment::ObservationError>
+RigAdjustment::EvaluateObservations() const {
+  std::vector<ObservationError> errors(observations_.size());
+  const int64_t num_observations = static_cast<int64_t>(observations_.size());
+  const int num_threads =
+      options_.num_threads > 0 ? options_.num_threads : omp_get_max_threads();
+#pragma omp parallel for schedule(static) num_threads(num_threads)
+  for (int64_t k = 0; k < num_observations; ++k) {
+    errors[k] = Evaluate(observations_[k]);
+  }
+  return errors;
+}
+
 double RigAdjustment::RmsError() const {
   double sum = 0;
-  for (const Observation& observation : observations_) {
-    sum += Evaluate(observation).residual.squaredNorm();
+  for (const ObservationError& error : EvaluateObservations()) {
+    sum += error.residual.squaredNorm();
   }
   return observations_.empty() ? 0 : std::sqrt(sum / observations_.size());
 }

@@ -99,6 +99,8 @@ class RigAdjustment {
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
   ObservationError Evaluate(const Observation& observation) const;
+  // Evaluate of every rig observation, in their order, on all threads.
+  std::vector<ObservationError> EvaluateObservations() const;
   ObservationError Evaluate(const MapObservationRef& observation) const;
   const MapObservation& MapObservationOf(
       const MapObservationRef& observation) const;

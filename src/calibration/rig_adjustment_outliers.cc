@@ -15,15 +15,14 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
   }
   // (slot, error) of the rig observations, then of the map observations of
   // the points being refined.
+  const std::vector<ObservationError> rig_errors = EvaluateObservations();
   std::vector<std::pair<int, ObservationError>> errors;
   errors.reserve(observations_.size());
   std::vector<double> depths;
   depths.reserve(observations_.size());
-  for (const Observation& observation : observations_) {
-    errors.emplace_back(CameraOf(observation), Evaluate(observation));
-    if (errors.back().second.depth > 0) {
-      depths.push_back(errors.back().second.depth);
-    }
+  for (size_t k = 0; k < observations_.size(); ++k) {
+    errors.emplace_back(CameraOf(observations_[k]), rig_errors[k]);
+    if (rig_errors[k].depth > 0) depths.push_back(rig_errors[k].depth);
   }
   const std::vector<MapObservationRef> map_observations =
       MapObservationsInProblem();
