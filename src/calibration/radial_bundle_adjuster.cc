@@ -1,7 +1,6 @@
 #include "src/calibration/radial_bundle_adjuster.h"
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -36,8 +35,8 @@ struct Observation {
 
 // The adjusted quantities, as Ceres parameter blocks.
 struct Parameters {
-  std::vector<std::array<double, 6>> cam_from_rig;
-  std::vector<std::array<double, 6>> rig_from_world;
+  std::vector<PoseParams> cam_from_rig;
+  std::vector<PoseParams> rig_from_world;
   std::vector<std::array<double, 2>> principal_points;
 };
 
@@ -124,20 +123,26 @@ BundleLevenbergMarquardtSummary Solve(
   solver_options.num_threads = options.num_threads;
   solver_options.print_progress = options.print_progress;
   BundleLevenbergMarquardt solver(solver_options);
-  const ceres::SubsetManifold tz_held(6, {5});
+  // The cost's tangent Jacobians (RadialRigCostFunction) are for these
+  // manifolds; the gauge pose's residuals (t_z held) take the ambient path.
+  const RigPoseManifold rig_pose_manifold;
+  const RadialCameraPoseManifold tz_held = MakeRadialCameraPoseManifold();
   int group = 0;
   bool tz_gauge_held = false;
   for (int j = 0; j < num_framesets; ++j) {
     if (!rig_added[j]) continue;
-    solver.AddParameterBlock(parameters->rig_from_world[j].data(), 6,
-                             tz_gauge_held ? nullptr : &tz_held, group++);
+    solver.AddParameterBlock(
+        parameters->rig_from_world[j].data(), 7,
+        tz_gauge_held ? static_cast<const ceres::Manifold*>(&rig_pose_manifold)
+                      : &tz_held,
+        group++);
     tz_gauge_held = true;
   }
   for (int i = 0; i < num_cameras; ++i) {
     if (!cam_added[i]) continue;
     bool in_group = false;
     if (i != reference_camera) {
-      solver.AddParameterBlock(parameters->cam_from_rig[i].data(), 6, &tz_held,
+      solver.AddParameterBlock(parameters->cam_from_rig[i].data(), 7, &tz_held,
                                group);
       in_group = true;
     }
@@ -279,7 +284,7 @@ Parameters ParametersOf(const RigCalibration& calibration) {
   Parameters parameters;
   for (size_t i = 0; i < calibration.cam_from_rig.size(); ++i) {
     parameters.cam_from_rig.push_back(
-        ToAngleAxisTranslation(calibration.cam_from_rig[i]));
+        ToPoseParams(calibration.cam_from_rig[i]));
     parameters.principal_points.push_back(
         {calibration.cameras[i].PrincipalPointX(),
          calibration.cameras[i].PrincipalPointY()});
@@ -288,7 +293,7 @@ Parameters ParametersOf(const RigCalibration& calibration) {
   for (size_t j = 0; j < calibration.rig_from_world.size(); ++j) {
     if (calibration.rig_from_world[j]) {
       parameters.rig_from_world[j] =
-          ToAngleAxisTranslation(*calibration.rig_from_world[j]);
+          ToPoseParams(*calibration.rig_from_world[j]);
     }
   }
   return parameters;
@@ -333,8 +338,7 @@ int WriteAdjusted(const std::vector<Observation>& observations,
   }
   for (int i = 0; i < num_cameras; ++i) {
     if (!cam_adjusted[i]) continue;
-    calibration->cam_from_rig[i] =
-        FromAngleAxisTranslation(parameters.cam_from_rig[i]);
+    calibration->cam_from_rig[i] = FromPoseParams(parameters.cam_from_rig[i]);
     calibration->cam_from_rig[i].translation.z() = 0;
     calibration->cameras[i].SetPrincipalPointX(
         parameters.principal_points[i][0]);
@@ -346,7 +350,7 @@ int WriteAdjusted(const std::vector<Observation>& observations,
   for (int j = 0; j < num_framesets; ++j) {
     if (rig_adjusted[j]) {
       calibration->rig_from_world[j] =
-          FromAngleAxisTranslation(parameters.rig_from_world[j]);
+          FromPoseParams(parameters.rig_from_world[j]);
     } else if (calibration->rig_from_world[j]) {
       ++num_skipped;
     }

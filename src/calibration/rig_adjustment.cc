@@ -9,17 +9,6 @@
 
 namespace rig_calibrator {
 
-PoseParams ToPoseParams(const Rigid3d& pose) {
-  return {pose.rotation.w(),   pose.rotation.x(),    pose.rotation.y(),
-          pose.rotation.z(),   pose.translation.x(), pose.translation.y(),
-          pose.translation.z()};
-}
-
-Rigid3d FromPoseParams(const PoseParams& params) {
-  return Rigid3d(Eigen::Quaterniond(params[0], params[1], params[2], params[3]),
-                 Eigen::Vector3d(params[4], params[5], params[6]));
-}
-
 RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
                              const RigDataset& dataset,
                              const RigCalibration& calibration)

@@ -20,13 +20,6 @@
 
 namespace rig_calibrator {
 
-// A pose as one Ceres parameter block, [qw, qx, qy, qz, tx, ty, tz] (the
-// layout of RigReprojectionCost), so that a rig pose is a single block of the
-// Schur elimination group.
-using PoseParams = std::array<double, 7>;
-PoseParams ToPoseParams(const Rigid3d& pose);
-Rigid3d FromPoseParams(const PoseParams& params);
-
 class RigAdjustment {
  public:
   // The observations are the inliers (inlier_mask) of the images of

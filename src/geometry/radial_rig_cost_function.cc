@@ -1,80 +1,57 @@
 #include "src/geometry/radial_rig_cost_function.h"
 
-#include <colmap/base/pose.h>
-
 #include <Eigen/Geometry>
-#include <cmath>
 
 #include "src/geometry/radial_residual.h"
 
 namespace rig_calibrator {
-namespace {
 
-// R(w) = exp([w]x) and the right Jacobian of SO(3),
-//   J_r(w) = I - (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2, t = |w|,
-// by its Taylor expansion I - [w]x / 2 + [w]x^2 / 6 for tiny t.
-void RotationAndRightJacobian(const double* angle_axis,
-                              Eigen::Matrix3d* rotation,
-                              Eigen::Matrix3d* right_jacobian) {
-  const Eigen::Map<const Eigen::Vector3d> w(angle_axis);
-  const double theta_sq = w.squaredNorm();
-  const Eigen::Matrix3d skew = colmap::CrossProductMatrix(w);
-  if (theta_sq < 1e-16) {
-    *rotation = Eigen::Matrix3d::Identity() + skew;
-    if (right_jacobian != nullptr) {
-      *right_jacobian =
-          Eigen::Matrix3d::Identity() - 0.5 * skew + skew * skew / 6.0;
-    }
-    return;
-  }
-  const double theta = std::sqrt(theta_sq);
-  *rotation = Eigen::AngleAxisd(theta, w / theta).toRotationMatrix();
-  if (right_jacobian != nullptr) {
-    *right_jacobian =
-        Eigen::Matrix3d::Identity() - (1 - std::cos(theta)) / theta_sq * skew +
-        (theta - std::sin(theta)) / (theta_sq * theta) * skew * skew;
-  }
+RadialRigCostFunction::RadialRigCostFunction(const Eigen::Vector2d& point2D,
+                                             const Eigen::Vector3d& point3D)
+    : point2D_(point2D), point3D_(point3D) {
+  set_num_residuals(2);
+  *mutable_parameter_block_sizes() = {7, 7, 2};
 }
-
-// The 2x6 Jacobian of e by a pose block (w, t) that maps v to R(w) v + t,
-// given d_out = de/d(R(w) v + t):
-//   de/dw = -d_out R(w) [v]x J_r(w),  de/dt = d_out.
-void WritePoseJacobian(const Eigen::Matrix<double, 2, 3>& d_out,
-                       const Eigen::Matrix3d& rotation,
-                       const Eigen::Vector3d& point,
-                       const Eigen::Matrix3d& right_jacobian,
-                       double* jacobian_row_major) {
-  Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
-      jacobian_row_major);
-  jacobian.leftCols<3>() =
-      -d_out * rotation * colmap::CrossProductMatrix(point) * right_jacobian;
-  jacobian.rightCols<3>() = d_out;
-}
-
-}  // namespace
 
 bool RadialRigCostFunction::Evaluate(double const* const* parameters,
                                      double* residuals,
                                      double** jacobians) const {
+  return EvaluateImpl</*kTangent=*/false>(parameters, residuals, jacobians);
+}
+
+int RadialRigCostFunction::TangentSize(int parameter_block) const {
+  return parameter_block == 0 ? 5 : parameter_block == 1 ? 6 : 0;
+}
+
+bool RadialRigCostFunction::EvaluateTangent(double const* const* parameters,
+                                            double* residuals,
+                                            double** jacobians) const {
+  return EvaluateImpl</*kTangent=*/true>(parameters, residuals, jacobians);
+}
+
+template <bool kTangent>
+bool RadialRigCostFunction::EvaluateImpl(double const* const* parameters,
+                                         double* residuals,
+                                         double** jacobians) const {
   const double* cam_from_rig = parameters[0];
   const double* rig_from_world = parameters[1];
   const double* principal_point = parameters[2];
-  const bool want_jacobians = jacobians != nullptr;
-  Eigen::Matrix3d rig_rotation, cam_rotation, rig_jacobian, cam_jacobian;
-  RotationAndRightJacobian(rig_from_world, &rig_rotation,
-                           want_jacobians ? &rig_jacobian : nullptr);
-  RotationAndRightJacobian(cam_from_rig, &cam_rotation,
-                           want_jacobians ? &cam_jacobian : nullptr);
+  const Eigen::Quaterniond cam_quaternion(cam_from_rig[0], cam_from_rig[1],
+                                          cam_from_rig[2], cam_from_rig[3]);
+  const Eigen::Quaterniond rig_quaternion(rig_from_world[0], rig_from_world[1],
+                                          rig_from_world[2], rig_from_world[3]);
+  const Eigen::Matrix3d cam_rotation = cam_quaternion.toRotationMatrix();
+  const Eigen::Matrix3d rig_rotation = rig_quaternion.toRotationMatrix();
+  const Eigen::Vector3d rig_rotated = rig_rotation * point3D_;
   const Eigen::Vector3d point_in_rig =
-      rig_rotation * point3D_ +
-      Eigen::Map<const Eigen::Vector3d>(rig_from_world + 3);
+      rig_rotated + Eigen::Map<const Eigen::Vector3d>(rig_from_world + 4);
+  const Eigen::Vector3d cam_rotated = cam_rotation * point_in_rig;
   const Eigen::Vector3d point_in_cam =
-      cam_rotation * point_in_rig +
-      Eigen::Map<const Eigen::Vector3d>(cam_from_rig + 3);
+      cam_rotated + Eigen::Map<const Eigen::Vector3d>(cam_from_rig + 4);
   const Eigen::Vector2d centered(point2D_.x() - principal_point[0],
                                  point2D_.y() - principal_point[1]);
   RadialResidual(centered.data(), point_in_cam.data(), residuals);
-  if (!want_jacobians) return true;
+  if (jacobians == nullptr) return true;
 
   // de/d(p0, p1) and de/d(x - c), as in RadialResidual's cases.
   Eigen::Matrix2d d_point = Eigen::Matrix2d::Zero();
@@ -96,12 +73,33 @@ bool RadialRigCostFunction::Evaluate(double const* const* parameters,
   Eigen::Matrix<double, 2, 3> d_cam = Eigen::Matrix<double, 2, 3>::Zero();
   d_cam.leftCols<2>() = d_point;
   if (jacobians[0] != nullptr) {
-    WritePoseJacobian(d_cam, cam_rotation, point_in_rig, cam_jacobian,
-                      jacobians[0]);
+    if constexpr (kTangent) {
+      Eigen::Map<Eigen::Matrix<double, 2, 5, Eigen::RowMajor>> jacobian(
+          jacobians[0]);
+      jacobian.leftCols<3>() = RotationTangentJacobian<2>(d_cam, cam_rotated);
+      jacobian.rightCols<2>() = d_point;
+    } else {
+      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> jacobian(
+          jacobians[0]);
+      jacobian.leftCols<4>() =
+          d_cam * RotatedPointQuaternionJacobian(cam_quaternion, point_in_rig);
+      jacobian.rightCols<3>() = d_cam;
+    }
   }
   if (jacobians[1] != nullptr) {
-    WritePoseJacobian(d_cam * cam_rotation, rig_rotation, point3D_,
-                      rig_jacobian, jacobians[1]);
+    const Eigen::Matrix<double, 2, 3> d_rig = d_cam * cam_rotation;
+    if constexpr (kTangent) {
+      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
+          jacobians[1]);
+      jacobian.leftCols<3>() = RotationTangentJacobian<2>(d_rig, rig_rotated);
+      jacobian.rightCols<3>() = d_rig;
+    } else {
+      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> jacobian(
+          jacobians[1]);
+      jacobian.leftCols<4>() =
+          d_rig * RotatedPointQuaternionJacobian(rig_quaternion, point3D_);
+      jacobian.rightCols<3>() = d_rig;
+    }
   }
   if (jacobians[2] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 2, Eigen::RowMajor>> jacobian(

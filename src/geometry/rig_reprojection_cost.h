@@ -34,39 +34,16 @@
 #pragma once
 
 #include <ceres/cost_function.h>
-#include <ceres/manifold.h>
 #include <colmap/base/pose.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "src/geometry/camera_model_jacobians.h"
+#include "src/geometry/pose_jacobians.h"
 #include "src/geometry/tangent_jacobian_cost.h"
 
 namespace rig_calibrator {
-
-// The manifold of a pose block [qw, qx, qy, qz, tx, ty, tz]: Ceres'
-// quaternion (left-multiplied update) times R^3; tangent (d, t).
-using RigPoseManifold = ceres::ProductManifold<ceres::QuaternionManifold,
-                                               ceres::EuclideanManifold<3>>;
-
-// d(R(q) p)/dq for a unit quaternion q = (w, v), as a 3 x 4 matrix over
-// (w, v_x, v_y, v_z): from
-//   R(q) p = p + 2 w (v x p) + 2 v x (v x p),
-//   d/dw = 2 v x p,  d/dv = -2 w [p]x + 2 (v p^T + (v.p) I - 2 p v^T).
-// Ceres' QuaternionManifold maps it to the 3 tangent directions. Inline: it
-// runs twice per residual evaluation.
-inline Eigen::Matrix<double, 3, 4> RotatedPointQuaternionJacobian(
-    const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d v = q.vec();
-  Eigen::Matrix<double, 3, 4> jacobian;
-  jacobian.col(0) = 2 * v.cross(p);
-  jacobian.rightCols<3>() =
-      -2 * q.w() * colmap::CrossProductMatrix(p) +
-      2 * (v * p.transpose() + v.dot(p) * Eigen::Matrix3d::Identity() -
-           2 * p * v.transpose());
-  return jacobian;
-}
 
 // r = pi_theta(P Q X) - x for the COLMAP model CameraModel (see the top of
 // the file); X is a fixed point given at construction or the fourth block.
@@ -113,11 +90,7 @@ class RigReprojectionCost final : public TangentJacobianCost {
                                 double* jacobian) {
     if constexpr (kTangent) {
       Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> out(jacobian);
-      // g (-2 [a]x) = 2 (a x g^T)^T for a row g.
-      for (int row = 0; row < 2; ++row) {
-        const Eigen::Vector3d g = d_pixel.row(row).transpose();
-        out.template block<1, 3>(row, 0) = 2 * rotated.cross(g).transpose();
-      }
+      out.template leftCols<3>() = RotationTangentJacobian<2>(d_pixel, rotated);
       out.template rightCols<3>() = d_pixel;
     } else {
       Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> out(jacobian);

@@ -61,6 +61,17 @@ std::array<double, 6> ToAngleAxisTranslation(const Rigid3d& pose) {
   return parameters;
 }
 
+PoseParams ToPoseParams(const Rigid3d& pose) {
+  return {pose.rotation.w(),   pose.rotation.x(),    pose.rotation.y(),
+          pose.rotation.z(),   pose.translation.x(), pose.translation.y(),
+          pose.translation.z()};
+}
+
+Rigid3d FromPoseParams(const PoseParams& params) {
+  return Rigid3d(Eigen::Quaterniond(params[0], params[1], params[2], params[3]),
+                 Eigen::Vector3d(params[4], params[5], params[6]));
+}
+
 Rigid3d FromAngleAxisTranslation(const std::array<double, 6>& parameters) {
   double quaternion[4];
   ceres::AngleAxisToQuaternion(parameters.data(), quaternion);

@@ -64,9 +64,17 @@ inline double AngleBetweenRad(const Eigen::Vector3d& a,
 }
 
 // A pose as one Ceres parameter block: (angle-axis of the rotation,
-// translation), the minimal 6-vector that the bundle adjusters optimize.
+// translation), the minimal 6-vector of the rig initialization's refinement
+// (rig_init_refinement.h).
 std::array<double, 6> ToAngleAxisTranslation(const Rigid3d& pose);
 Rigid3d FromAngleAxisTranslation(const std::array<double, 6>& parameters);
+
+// A pose as one parameter block of the bundle adjustments' solver,
+// [qw, qx, qy, qz, tx, ty, tz], refined on RigPoseManifold (pose_jacobians.h):
+// a rig pose is a single block of the Schur elimination group.
+using PoseParams = std::array<double, 7>;
+PoseParams ToPoseParams(const Rigid3d& pose);
+Rigid3d FromPoseParams(const PoseParams& params);
 
 // Projects a 3x3 matrix onto the closest rotation in Frobenius norm
 // (SVD, with the determinant forced to +1).
