@@ -40,73 +40,9 @@ using ConstRowMajorMap =
 // The small dense products of the loops below, on row-major blocks with
 // run-time sizes (a group has 6 to ~20 columns), written out: Eigen's
 // dynamic-size products allocate temporaries and take its large-matrix path.
-// The common shapes (k = 2 or 3 rows: an observation's or a point's; up to
-// kMaxFixedColumns columns) run as instances with compile-time sizes, whose
-// inner loops the compiler unrolls and vectorizes; the order of the
-// additions into each element is the same, so the results are too.
-constexpr int kMaxFixedColumns = 16;
-
 // c (m x n, row stride ldc) += sign * a^T b, a: k x m, b: k x n.
-template <int K, int N>
-void AddATransposeBFixed(const double* a, const double* b, int m, double sign,
-                         double* c, int ldc) {
-  for (int i = 0; i < m; ++i) {
-    double* row = c + i * ldc;
-    for (int l = 0; l < K; ++l) {
-      const double factor = sign * a[l * m + i];
-      const double* b_row = b + l * N;
-      for (int j = 0; j < N; ++j) row[j] += factor * b_row[j];
-    }
-  }
-}
-// c (m x n, row stride ldc) += a b, a: m x k, b: k x n.
-template <int K, int N>
-void AddABFixed(const double* a, const double* b, int m, double* c, int ldc) {
-  for (int i = 0; i < m; ++i) {
-    double* row = c + i * ldc;
-    for (int l = 0; l < K; ++l) {
-      const double factor = a[i * K + l];
-      const double* b_row = b + l * N;
-      for (int j = 0; j < N; ++j) row[j] += factor * b_row[j];
-    }
-  }
-}
-
-// The instance of Kernel<K, N> for run-time (k, n), or false.
-template <template <int, int> class Kernel, int N = 1>
-struct FixedDispatch {
-  template <typename... Args>
-  static bool Run(int k, int n, Args... args) {
-    if (n == N) {
-      if (k == 2) return Kernel<2, N>::Run(args...), true;
-      if (k == 3) return Kernel<3, N>::Run(args...), true;
-      return false;
-    }
-    if constexpr (N < kMaxFixedColumns) {
-      return FixedDispatch<Kernel, N + 1>::Run(k, n, args...);
-    }
-    return false;
-  }
-};
-template <int K, int N>
-struct AddATransposeBKernel {
-  static void Run(const double* a, const double* b, int m, double sign,
-                  double* c, int ldc) {
-    AddATransposeBFixed<K, N>(a, b, m, sign, c, ldc);
-  }
-};
-template <int K, int N>
-struct AddABKernel {
-  static void Run(const double* a, const double* b, int m, double* c, int ldc) {
-    AddABFixed<K, N>(a, b, m, c, ldc);
-  }
-};
-
 inline void AddATransposeB(const double* a, const double* b, int k, int m,
                            int n, double sign, double* c, int ldc) {
-  if (FixedDispatch<AddATransposeBKernel>::Run(k, n, a, b, m, sign, c, ldc)) {
-    return;
-  }
   for (int i = 0; i < m; ++i) {
     double* row = c + i * ldc;
     for (int l = 0; l < k; ++l) {
@@ -128,9 +64,9 @@ inline void AddATransposeBUpper(const double* a, const double* b, int k, int m,
     }
   }
 }
+// c (m x n, row stride ldc) += a b, a: m x k, b: k x n.
 inline void AddAB(const double* a, const double* b, int m, int k, int n,
                   double* c, int ldc) {
-  if (FixedDispatch<AddABKernel>::Run(k, n, a, b, m, c, ldc)) return;
   for (int i = 0; i < m; ++i) {
     double* row = c + i * ldc;
     for (int l = 0; l < k; ++l) {
