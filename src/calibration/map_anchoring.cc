@@ -47,23 +47,34 @@ bool AnchorRefinedPointsToMap(const RigDataset& dataset,
   if (refined_points.size() < 3) {
     return false;
   }
-  std::unordered_map<int64_t, Eigen::Vector3d> map_points =
-      dataset.map_points3D;
+  // A refined point's map position: map_points3D's, else that of its first
+  // correspondence. Only the refined points are looked up (copying the whole
+  // map instead took 13 of AdjustRig's 500 ms at 100 framesets x 10 cameras).
+  Eigen::Matrix3Xd refined(3, refined_points.size());
+  Eigen::Matrix3Xd mapped(3, refined_points.size());
+  std::unordered_map<int64_t, Eigen::Index> unmapped_columns;
+  Eigen::Index column = 0;
+  for (const auto& [point3D_id, point] : refined_points) {
+    refined.col(column) = point;
+    const auto it = dataset.map_points3D.find(point3D_id);
+    if (it != dataset.map_points3D.end()) {
+      mapped.col(column) = it->second;
+    } else {
+      unmapped_columns.emplace(point3D_id, column);
+    }
+    ++column;
+  }
   for (const RigImage& image : dataset.images) {
+    if (unmapped_columns.empty()) break;
     for (const Correspondence& correspondence : image.correspondences) {
-      if (refined_points.count(correspondence.point3D_id) > 0) {
-        map_points.emplace(correspondence.point3D_id, correspondence.point3D);
+      const auto it = unmapped_columns.find(correspondence.point3D_id);
+      if (it != unmapped_columns.end()) {
+        mapped.col(it->second) = correspondence.point3D;
+        unmapped_columns.erase(it);
       }
     }
   }
-  Eigen::Matrix3Xd refined(3, refined_points.size());
-  Eigen::Matrix3Xd mapped(3, refined_points.size());
-  int column = 0;
-  for (const auto& [point3D_id, point] : refined_points) {
-    refined.col(column) = point;
-    mapped.col(column) = map_points.at(point3D_id);
-    ++column;
-  }
+  if (!unmapped_columns.empty()) return false;
   ApplySimilarity(Eigen::umeyama(refined, mapped, true), calibration);
   return true;
 }

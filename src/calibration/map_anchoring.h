@@ -27,7 +27,7 @@ namespace rig_calibrator {
 // for every rig_from_world Q and cam_from_rig P (and map_cam_from_world as
 // Q, with P the identity), so that every projection of P' Q' X' equals that
 // of P Q X. False (nothing changed) with fewer than 3 refined points, which
-// do not determine a similarity.
+// do not determine a similarity, or with a refined point of no map position.
 bool AnchorRefinedPointsToMap(const RigDataset& dataset,
                               RigCalibration* calibration);
 

@@ -200,6 +200,7 @@ const Eigen::Vector3d& RigAdjustment::PointOf(
 void RigAdjustment::SelectRefinedPoints() {
   const bool first_selection = !points_selected_;
   points_selected_ = true;
+  selection_current_ = true;
   // The rig observations' points, sorted by id (runs of one point), with the
   // observation: counting by sorting, not hashing, 945 000 observations
   // at 500 framesets x 10 cameras.

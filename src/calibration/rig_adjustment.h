@@ -152,6 +152,9 @@ class RigAdjustment {
   std::vector<std::vector<char>> map_rejected_;
   size_t num_map_rejected_ = 0;
   bool points_selected_ = false;
+  // No observation has left since the last SelectRefinedPoints, so that
+  // selection still holds.
+  bool selection_current_ = false;
   // cam_from_rig of a map image seen as a one-camera rig (the identity,
   // constant), so that its residuals are RigReprojectionCosts too.
   PoseParams identity_pose_ = {1, 0, 0, 0, 0, 0, 0};

@@ -58,6 +58,7 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
       ++num_removed;
     }
   }
+  if (num_removed > 0) selection_current_ = false;
   return num_removed;
 }
 
@@ -80,6 +81,7 @@ size_t RigAdjustment::RejectMapOutliers() {
     }
   }
   num_map_rejected_ += num_rejected;
+  if (num_rejected > 0) selection_current_ = false;
   return num_rejected;
 }
 

@@ -12,7 +12,7 @@ namespace rig_calibrator {
 
 bool RigAdjustment::Solve(double function_tolerance,
                           BundleLevenbergMarquardtSummary* summary) {
-  if (options_.refine_points) {
+  if (options_.refine_points && !selection_current_) {
     SelectRefinedPoints();
   }
   if (solver_ == nullptr) {
