@@ -80,7 +80,8 @@ inline void AddAB(const double* a, const double* b, int m, int k, int n,
 // Sorts `items` stably by key(item) in [0, range): a counting sort, O(n +
 // range). The structure's sorts run over ~10^5-10^7 items whose keys are
 // group indices (a few hundred to a few thousand), where std::sort's
-// n log n comparisons were half of the structure's time.
+// n log n comparisons were a third of the structure's time (perf, 100
+// framesets x 10 cameras).
 template <typename T, typename Key>
 void CountingSort(int range, Key key, std::vector<T>* items,
                   std::vector<T>* buffer) {
