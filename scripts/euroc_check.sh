@@ -8,7 +8,7 @@
 #      motion), one self-calibrated camera per folder, and scales it to
 #      metres by the known stereo baseline measured on those map framesets,
 #   3. calibrates the pair from the odd framesets, which are not in the map
-#      (scripts/calibrate_rig.sh, OPENCV for both cameras),
+#      (scripts/calibrate_rig.sh, camera model EUROC_CAMERA_MODEL),
 #   4. compares with the reference (rig_calibrator evaluate) and prints the
 #      table, the recovered baseline and rotation, and the diagnosis inputs:
 #      the rig's motion in the images, the map's self-calibrated focal
@@ -29,6 +29,8 @@
 #   EUROC_MAP_EVERY    map framesets: every N-th (default 8, i.e. 12 framesets)
 #   EUROC_MAP_MODEL    camera model of the map's self-calibration (default
 #                      RADIAL: one focal length, k1, k2)
+#   EUROC_CAMERA_MODEL the calibration's --RigCalibrator.camera_model (default
+#                      auto, the command's default; OPENCV is the reference's)
 #   EUROC_DIAGNOSTIC   1 (default): also calibrate against the map
 #                      re-triangulated with the reference intrinsics; 0: skip
 #   EUROC_SKIP_BUILD   1: use the built tree as it is (else scripts/build.sh)
@@ -43,6 +45,7 @@ out="${1:-$repo/demo_output/euroc}"
 data="${EUROC_DIR:-/work/shared/data/euroc_v1_01_micro}"
 map_every="${EUROC_MAP_EVERY:-8}"
 map_model="${EUROC_MAP_MODEL:-RADIAL}"
+camera_model="${EUROC_CAMERA_MODEL:-auto}"
 diagnostic="${EUROC_DIAGNOSTIC:-1}"
 tools="$repo/scripts/euroc_tools.py"
 marker=".euroc_check_output"
@@ -183,7 +186,7 @@ run_step "map (colmap, stereo framesets)" build_map
 run_step "calibration (colmap features + rig_calibrator)" \
   bash "$repo/scripts/calibrate_rig.sh" \
   "$map/database.db" "$map/sparse/0" "$out/rig_images" "$out/rig" \
-  --RigCalibrator.camera_model OPENCV
+  --RigCalibrator.camera_model "$camera_model"
 
 # --- 5. Evaluation -------------------------------------------------------------------
 # Prints evaluate's tables (all-camera alignment, then cam0 = rig frame so
@@ -260,7 +263,7 @@ diagnostic_map() {
     --output_path "$diag/sparse/0" --transform_path "$diag/scale.txt" || return 1
   "$rig_calibrator" --database_path "$out/rig/database.db" \
     --image_path "$out/rig_images" --input_path "$diag/sparse/0" \
-    --output_path "$diag/calibration" --RigCalibrator.camera_model OPENCV \
+    --output_path "$diag/calibration" --RigCalibrator.camera_model "$camera_model" \
     > "$diag/rig_calibrator.log" 2>&1 || { tail -n 20 "$diag/rig_calibrator.log" >&2; return 1; }
   sed -n '/^== Result/,/^$/p' "$diag/rig_calibrator.log"
   evaluate "$diag/calibration" diagnostic

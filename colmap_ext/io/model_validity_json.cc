@@ -32,10 +32,16 @@ Json ValidityJson(const ModelValidity& validity) {
       rings.push_back({{"min_radius_px", FiniteOrNull(ring.min_radius_px)},
                        {"max_radius_px", FiniteOrNull(ring.max_radius_px)},
                        {"num_points", ring.num_points},
+                       {"num_images", ring.num_groups},
                        {"mean_radial_px", FiniteOrNull(ring.mean_radial_px)},
-                       {"z", FiniteOrNull(ring.z)}});
+                       {"standard_error_px",
+                        FiniteOrNull(ring.standard_error_px)},
+                       {"z", FiniteOrNull(ring.z)},
+                       {"z_threshold", FiniteOrNull(ring.z_threshold)}});
     }
     node["radial_residual_rings"] = rings;
+    node["systematic_floor_px"] =
+        FiniteOrNull(validity.residual_profile->systematic_floor_px);
   }
   node["suggested_model"] = validity.suggested_model.empty()
                                 ? Json(nullptr)
@@ -48,6 +54,7 @@ Json ChoiceJson(const ModelChoice& choice) {
   Json node;
   node["chosen"] = choice.chosen.empty() ? Json(nullptr) : Json(choice.chosen);
   node["reason"] = choice.reason;
+  node["uncertain"] = choice.uncertain;
   node["candidates"] = Json::array();
   for (const ModelCandidate& candidate : choice.candidates) {
     node["candidates"].push_back(

@@ -5,10 +5,14 @@
 //     finite), "fold_radius_px" (null: no fold), "fold_angle_deg",
 //     "corner_radius_px", "fits_data" (the radial residual check),
 //     "radial_residual_rings" (when evaluated): [{"min_radius_px",
-//     "max_radius_px", "num_points", "mean_radial_px", "z"}],
+//     "max_radius_px", "num_points", "num_images", "mean_radial_px",
+//     "standard_error_px" (clustered by image), "z", "z_threshold"}],
+//     "systematic_floor_px" (the map's own systematic level, which a ring's
+//     |mean| must exceed significantly; 0 without map images),
 //     "suggested_model" (null: none), "message"}
 //   "model_choice" (cameras whose model was "auto" only): {"chosen",
-//     "reason", "candidates": [{"model", "valid", "heldout_rms_px",
+//     "reason", "uncertain" (the choice failed a check; warned),
+//     "candidates": [{"model", "valid", "heldout_rms_px",
 //     "train_rms_px", "num_params", "num_inliers", "chosen", "note"}]}
 #pragma once
 

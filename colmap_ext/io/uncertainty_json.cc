@@ -31,6 +31,9 @@ Json CameraJson(const CalibrationUncertainty& uncertainty,
   node["rotation_axis_stddev_deg"] = Vector(camera.rotation_axis_stddev_deg);
   node["translation_stddev"] = Vector(camera.translation_stddev);
   node["center_in_rig_stddev"] = Vector(camera.center_in_rig_stddev);
+  node["between_framesets_factor"] =
+      uncertainty.num_clusters > 0 ? Number(camera.between_framesets_factor)
+                                   : Json(nullptr);
   const ProjectionUncertainty& projection = camera.projection;
   if (projection.stddev_px.empty()) {
     node["projection_stddev_px"] = nullptr;
@@ -155,6 +158,10 @@ std::vector<std::string> UncertaintyLines(
            << Fixed(camera.projection.max_at.y(), 0) << ")";
     } else if (!camera.determined) {
       line << ", some parameters undetermined";
+    }
+    if (camera.between_framesets_factor > kBetweenFramesetsNoteFactor) {
+      line << "; framesets disagree " << Fixed(camera.between_framesets_factor, 1)
+           << "x beyond the pixel noise";
     }
     lines.push_back(line.str());
   }

@@ -18,7 +18,9 @@ namespace rig_calibrator {
 // "uncertainty": {residual_scale_px, params_stddev (0: held, null:
 // undetermined), rotation_stddev_deg (sqrt of the trace of the rotation
 // vector's covariance), rotation_axis_stddev_deg, translation_stddev,
-// center_in_rig_stddev, projection_stddev_px: {median, max, max_at, depth,
+// center_in_rig_stddev, between_framesets_factor (max over the parameters
+// of the between-framesets sigma over the noise sigma; null when not
+// computed), projection_stddev_px: {median, max, max_at, depth,
 // grid: {cols, rows, values (row-major, cell centres, null where the model
 // does not unproject)}}}, null for a camera without one; and
 // root["uncertainty_method"] (what was computed, or why not). Never NaN.
@@ -29,6 +31,11 @@ void AddUncertaintyJson(const CalibrationUncertainty& uncertainty,
 // (RigDescriptionCamera::comments), in the dataset's camera order.
 void AddUncertaintyComments(const CalibrationUncertainty& uncertainty,
                             RigDescription* rig);
+
+// A camera whose between-framesets sigma exceeds its noise sigma by more
+// than this gets a note in its terminal line: below it the two agree within
+// what a handful of framesets can tell.
+constexpr double kBetweenFramesetsNoteFactor = 1.5;
 
 // The lines of the terminal result: per camera sigma of the focal length(s),
 // principal point, rotation and centre, and the projection uncertainty.

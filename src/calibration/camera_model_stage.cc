@@ -14,12 +14,14 @@ CameraModelReport& CameraModelReportOf(const RigDataset& dataset,
 }
 
 // The final inliers of camera `camera_index`, observed and projected through
-// the final calibration (refined map points where the map was refined).
+// the final calibration (refined map points where the map was refined), and
+// the image of each (the clusters of the ring check's standard error).
 void FinalInlierPixels(const RigDataset& dataset,
                        const RigCalibration& calibration,
                        const int camera_index,
                        std::vector<Eigen::Vector2d>* observed,
-                       std::vector<Eigen::Vector2d>* projected) {
+                       std::vector<Eigen::Vector2d>* projected,
+                       std::vector<int>* images) {
   const colmap::Camera& camera = calibration.cameras[camera_index];
   for (size_t i = 0; i < dataset.images.size(); ++i) {
     const RigImage& image = dataset.images[i];
@@ -44,8 +46,58 @@ void FinalInlierPixels(const RigDataset& dataset,
       if (!(point_cam.z() > 0)) continue;
       observed->push_back(correspondence.point2D);
       projected->push_back(camera.WorldToImage(point_cam.hnormalized()));
+      images->push_back(static_cast<int>(i));
     }
   }
+}
+
+// The map's own systematic level (see the header): the largest |ring mean|
+// of a significant ring over the map cameras' profiles; 0 without map
+// images in the adjustment.
+double MapSystematicFloorPx(const PipelineOptions& options,
+                            const RigDataset& dataset,
+                            const RigCalibration& calibration) {
+  if (calibration.map_cam_from_world.size() != dataset.map_images.size() ||
+      calibration.map_observation_rejected.size() !=
+          dataset.map_images.size() ||
+      calibration.map_cameras.size() != dataset.map_cameras.size()) {
+    return 0;
+  }
+  RadialResidualProfileOptions profile_options =
+      options.model_selection.validity.residual_profile;
+  double floor = 0;
+  for (size_t mc = 0; mc < calibration.map_cameras.size(); ++mc) {
+    const colmap::Camera& camera = calibration.map_cameras[mc];
+    std::vector<Eigen::Vector2d> observed, projected;
+    std::vector<int> images;
+    for (size_t m = 0; m < dataset.map_images.size(); ++m) {
+      const MapImage& image = dataset.map_images[m];
+      if (image.camera_index != static_cast<int>(mc)) continue;
+      for (size_t k = 0; k < image.observations.size(); ++k) {
+        const auto point = calibration.refined_points3D.find(
+            image.observations[k].point3D_id);
+        if (calibration.map_observation_rejected[m][k] ||
+            point == calibration.refined_points3D.end()) {
+          continue;
+        }
+        const Eigen::Vector3d point_cam =
+            calibration.map_cam_from_world[m] * point->second;
+        if (!(point_cam.z() > 0)) continue;
+        observed.push_back(image.observations[k].point2D);
+        projected.push_back(camera.WorldToImage(point_cam.hnormalized()));
+        images.push_back(static_cast<int>(m));
+      }
+    }
+    const RadialResidualProfile profile = ComputeRadialResidualProfile(
+        Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
+        observed, projected, images, profile_options);
+    for (const RadialResidualRing& ring : profile.rings) {
+      if (std::abs(ring.z) >= ring.z_threshold) {
+        floor = std::max(floor, std::abs(ring.mean_radial_px));
+      }
+    }
+  }
+  return floor;
 }
 
 }  // namespace
@@ -87,6 +139,13 @@ void ReportModelChoice(const PipelineOptions& options,
                        PipelineReport* report) {
   if (!choice) return;
   CameraModelReportOf(dataset, camera_index, report).choice = *choice;
+  if (choice->uncertain) {
+    AddDiagnostic(report, Diagnostic::Level::kWarning,
+                  "uncertain_model_choice",
+                  "camera " + dataset.cameras[camera_index].name + ": " +
+                      choice->reason,
+                  {camera_index});
+  }
   if (options.print_progress) {
     std::cout << "  " << dataset.cameras[camera_index].name
               << ": automatic model choice\n"
@@ -142,21 +201,26 @@ void CheckCameraModels(const PipelineOptions& options,
                        const RigDataset& dataset,
                        const RigCalibration& calibration,
                        PipelineReport* report) {
+  RadialResidualProfileOptions profile_options =
+      options.model_selection.validity.residual_profile;
+  profile_options.systematic_floor_px =
+      MapSystematicFloorPx(options, dataset, calibration);
   for (size_t c = 0; c < dataset.cameras.size(); ++c) {
     if (!calibration.camera_calibrated[c]) continue;
     const colmap::Camera& camera = calibration.cameras[c];
     ModelValidity validity =
         CheckModelValidity(camera, options.model_selection.validity);
     std::vector<Eigen::Vector2d> observed, projected;
+    std::vector<int> images;
     FinalInlierPixels(dataset, calibration, static_cast<int>(c), &observed,
-                      &projected);
+                      &projected, &images);
     const IntrinsicsRefinement& refinement = dataset.cameras[c].refinement;
     const bool parameters_held = !refinement.focal_length ||
                                  !refinement.principal_point ||
                                  !refinement.extra_params;
     const RadialResidualProfile profile = ComputeRadialResidualProfile(
         Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
-        observed, projected, options.model_selection.validity.residual_profile);
+        observed, projected, images, profile_options);
     AddResidualProfileCheck(camera, profile, parameters_held, &validity);
     if (parameters_held && !validity.fits_data) {
       AddDiagnostic(

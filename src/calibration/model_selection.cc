@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iomanip>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -212,12 +213,15 @@ std::string Fixed(double value, int precision) {
 }
 
 // The residual profile of a fit over its inliers (radial_residual_profile.h),
-// the points projected with the fit's tz as in the upgrade.
+// the points projected with the fit's tz as in the upgrade, clustered by
+// `groups` (the frameset of every row: one image of this camera each).
 RadialResidualProfile FitResidualProfile(
     const ModelSelectionOptions& options, const CandidateFit& fit,
     const std::vector<Eigen::Vector2d>& points2D,
-    const std::vector<Eigen::Vector3d>& points_cam) {
+    const std::vector<Eigen::Vector3d>& points_cam,
+    const std::vector<int>& groups) {
   std::vector<Eigen::Vector2d> observed, projected;
+  std::vector<int> observed_groups;
   for (size_t row = 0; row < points2D.size(); ++row) {
     if (row >= fit.result.inlier_mask.size() || !fit.result.inlier_mask[row]) {
       continue;
@@ -227,11 +231,12 @@ RadialResidualProfile FitResidualProfile(
     observed.push_back(points2D[row]);
     projected.push_back(fit.camera.WorldToImage(Eigen::Vector2d(
         points_cam[row].x() / depth, points_cam[row].y() / depth)));
+    observed_groups.push_back(groups[row]);
   }
   return ComputeRadialResidualProfile(
       Eigen::Vector2d(fit.camera.PrincipalPointX(),
                       fit.camera.PrincipalPointY()),
-      observed, projected, options.validity.residual_profile);
+      observed, projected, observed_groups, options.validity.residual_profile);
 }
 
 // Fits `model` by the upgrade from `camera`'s size and principal point and
@@ -243,6 +248,7 @@ CandidateFit FitCandidate(const std::string& model,
                           const CameraUpgradeOptions& upgrade_options,
                           const std::vector<Eigen::Vector2d>& points2D,
                           const std::vector<Eigen::Vector3d>& points_cam,
+                          const std::vector<int>& groups,
                           const colmap::Camera& camera, bool check_data,
                           ModelCandidate* candidate) {
   CandidateFit fit;
@@ -259,7 +265,8 @@ CandidateFit FitCandidate(const std::string& model,
   fit.validity = CheckModelValidity(fit.camera, options.validity);
   if (check_data) {
     AddResidualProfileCheck(
-        fit.camera, FitResidualProfile(options, fit, points2D, points_cam),
+        fit.camera,
+        FitResidualProfile(options, fit, points2D, points_cam, groups),
         /*parameters_held=*/false, &fit.validity);
   }
   candidate->valid = fit.validity.valid;
@@ -287,7 +294,7 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
       continue;
     }
     fit = FitCandidate(model, options, upgrade_options, points2D, points_cam,
-                       *camera, /*check_data=*/false, &candidate);
+                       groups, *camera, /*check_data=*/false, &candidate);
     choice->candidates.push_back(candidate);
     fits.push_back(fit);
   }
@@ -397,45 +404,92 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
   return true;
 }
 
+// How far a fit's worst ring is beyond the data check's threshold (|z| over
+// the threshold; 0 when the profile was not evaluated).
+double MisfitRatio(const std::optional<RadialResidualProfile>& profile) {
+  double worst = 0;
+  if (!profile) return worst;
+  for (const RadialResidualRing& ring : profile->rings) {
+    if (ring.z_threshold > 0 && std::isfinite(ring.z_threshold)) {
+      worst = std::max(worst, std::abs(ring.z) / ring.z_threshold);
+    }
+  }
+  return worst;
+}
+
 // Too few framesets for the held-out comparison: kFewFramesetsModels in
 // order, the first that is valid over the image and follows the lens where
-// there are data (model_validity.h, checks 1-3) wins.
+// there are data (model_validity.h, checks 1-3) wins. When none follows the
+// lens, the data check has failed for every candidate that is valid over the
+// image: the one whose worst ring is least far beyond its threshold is used,
+// with the reason saying so (a statistical test is no reason to leave a
+// camera uncalibrated; the final check reports the misfit again).
 bool SelectCameraModelFromFewFramesets(
     const ModelSelectionOptions& options,
     const CameraUpgradeOptions& upgrade_options,
     const std::vector<Eigen::Vector2d>& points2D,
-    const std::vector<Eigen::Vector3d>& points_cam, int num_framesets,
-    colmap::Camera* camera, CameraUpgradeResult* result, ModelChoice* choice) {
+    const std::vector<Eigen::Vector3d>& points_cam,
+    const std::vector<int>& groups, int num_framesets, colmap::Camera* camera,
+    CameraUpgradeResult* result, ModelChoice* choice) {
   const std::string why = std::to_string(num_framesets) +
                           " framesets see this camera, too few to compare "
                           "models by held-out error (at least " +
                           std::to_string(options.min_num_framesets) + ")";
+  std::vector<CandidateFit> fits;
   for (const char* model : kFewFramesetsModels) {
     ModelCandidate candidate;
     candidate.model = model;
-    const CandidateFit fit =
-        FitCandidate(model, options, upgrade_options, points2D, points_cam,
-                     *camera, /*check_data=*/true, &candidate);
-    if (!candidate.valid) {
-      choice->candidates.push_back(candidate);
-      continue;
-    }
-    candidate.chosen = true;
-    candidate.note = "the first valid one";
+    fits.push_back(FitCandidate(model, options, upgrade_options, points2D,
+                                points_cam, groups, *camera,
+                                /*check_data=*/true, &candidate));
     choice->candidates.push_back(candidate);
+    if (!candidate.valid) continue;
+    choice->candidates.back().chosen = true;
+    choice->candidates.back().note = "the first valid one";
     choice->chosen = model;
     choice->reason = why + ": " + model +
                      ", the first of OPENCV, OPENCV_FISHEYE that is valid "
                      "over the image and follows the lens where there are "
                      "data";
-    *camera = fit.camera;
-    *result = fit.result;
+    *camera = fits.back().camera;
+    *result = fits.back().result;
     return true;
   }
-  result->error_message = why + ", and neither OPENCV nor OPENCV_FISHEYE " +
-                          "could be fitted and is valid over the whole image";
-  choice->reason = result->error_message;
-  return false;
+  int best = -1;
+  for (size_t m = 0; m < fits.size(); ++m) {
+    const ModelValidity& validity = fits[m].validity;
+    const bool geometry_valid =
+        choice->candidates[m].fitted && validity.monotonic &&
+        validity.max_roundtrip_error_px <=
+            options.validity.max_roundtrip_error_px;
+    if (geometry_valid &&
+        (best < 0 || MisfitRatio(validity.residual_profile) <
+                         MisfitRatio(fits[best].validity.residual_profile))) {
+      best = static_cast<int>(m);
+    }
+  }
+  if (best < 0) {
+    result->error_message = why + ", and neither OPENCV nor OPENCV_FISHEYE " +
+                            "could be fitted and is valid over the whole image";
+    choice->reason = result->error_message;
+    return false;
+  }
+  ModelCandidate& candidate = choice->candidates[best];
+  candidate.chosen = true;
+  candidate.note += " (used: the smaller misfit)";
+  choice->chosen = candidate.model;
+  choice->reason =
+      why + ": neither OPENCV nor OPENCV_FISHEYE follows the lens where there "
+            "are data by the ring check; " +
+      candidate.model +
+      " is used, valid over the image and the closer of the two (worst ring " +
+      Fixed(MisfitRatio(fits[best].validity.residual_profile), 1) +
+      "x its threshold). The choice is not sure: check the camera's "
+      "residuals, or give a model";
+  choice->uncertain = true;
+  *camera = fits[best].camera;
+  *result = fits[best].result;
+  return true;
 }
 
 }  // namespace
@@ -458,8 +512,8 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
       static_cast<int>(std::set<int>(groups.begin(), groups.end()).size());
   if (num_framesets < options.min_num_framesets) {
     return SelectCameraModelFromFewFramesets(options, upgrade_options, points2D,
-                                             points_cam, num_framesets, camera,
-                                             result, choice);
+                                             points_cam, groups, num_framesets,
+                                             camera, result, choice);
   }
   if (points2D.size() <= static_cast<size_t>(options.max_num_fit_rows)) {
     return SelectCameraModelOnRows(options, upgrade_options, points2D,

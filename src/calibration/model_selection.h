@@ -95,6 +95,9 @@ struct ModelCandidate {
 struct ModelChoice {
   std::string chosen;  // empty when no candidate could be used
   std::string reason;
+  // The chosen model failed a check that a sure choice passes (the reason
+  // says which): the pipeline warns (diagnostic "uncertain_model_choice").
+  bool uncertain = false;
   std::vector<ModelCandidate> candidates;
 };
 

@@ -27,6 +27,9 @@ namespace rig_calibrator {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Fewer clusters (framesets and map images) leave no spread between them
+// worth estimating: the between-framesets covariance is not computed.
+constexpr int kMinNumClusters = 3;
 // Eigenvalues of a Jacobi-scaled (unit-diagonal) information matrix below
 // this are directions the data do not determine: with unit diagonal the
 // eigenvalues lie in (0, n], and 1e-10 is a condition number of 1e10, far
@@ -108,6 +111,17 @@ struct Observation {
   int rig_block = -1, cam_block = -1, intrinsics_block = -1;
   const std::vector<int>* free_intrinsics = nullptr;
   int rig_camera = -1;  // the rig camera, -1 for a map image
+  // The cluster of the between-framesets covariance: the frameset of a rig
+  // image, num_framesets + m for map image m.
+  int cluster = -1;
+};
+
+// One observation evaluated (UncertaintyProblem::EvaluateObservation).
+struct ObservationJacobian {
+  Eigen::Vector2d residual = Eigen::Vector2d::Zero();
+  std::vector<std::pair<int, Eigen::MatrixXd>> entries;
+  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> j_point;
+  std::vector<double> j_intrinsics;  // scratch: over all the model's params
 };
 
 // A parameter block of the reduced system: O (nuisance: rig poses, map
@@ -267,6 +281,8 @@ class UncertaintyProblem {
   void AssignBlocks();
   bool Accumulate();
   struct AccumulationChunk;
+  bool EvaluateObservation(const Observation& observation,
+                           ObservationJacobian* out) const;
   void AccumulateObservation(const Observation& observation, PointTerms* point,
                              AccumulationChunk* chunk) const;
   void EliminatePoint(PointTerms* point, AccumulationChunk* chunk) const;
@@ -274,6 +290,7 @@ class UncertaintyProblem {
   void AddGaugePriors();
   bool Marginalize(CalibrationUncertainty* result);
   void AnchorScale();
+  void BetweenFramesetsCovariance(const Eigen::MatrixXd& unanchored);
   void FillCameras(const UncertaintyOptions& options,
                    CalibrationUncertainty* result) const;
   void FillProjection(int camera, const UncertaintyOptions& options,
@@ -317,6 +334,15 @@ class UncertaintyProblem {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_o_;
   Eigen::VectorXd scale_o_;
   Eigen::MatrixXd r_oc_, x_oc_;
+  // With a free gauge, H^-1 a of the anchoring's scale (AnchorScale): over
+  // O and C, and per refined point; empty otherwise.
+  Eigen::VectorXd anchor_v_;
+  std::vector<Eigen::Vector3d> anchor_v_points_;
+  // Over C, the between-framesets covariance (BetweenFramesetsCovariance),
+  // anchored like covariance_c_ but not scaled by a noise level; and the
+  // number of clusters it was computed from (0: not computed).
+  Eigen::MatrixXd cluster_covariance_c_;
+  int num_clusters_ = 0;
   mutable std::map<int, std::unique_ptr<ceres::CostFunction>> costs_;
 };
 
@@ -380,12 +406,20 @@ void UncertaintyProblem::CollectObservations() {
           refined != calibration_.refined_points3D.end()) {
         observation.point = refined->second;
         observation.point_index = point_index(correspondence.point3D_id);
+      } else if (refine_points && options_.refine_map) {
+        // With the map adjusted, a point the adjustment does not refine is
+        // one that only this observation sees (final_bundle_adjuster.h):
+        // held there, but it says nothing of the calibration, and taken as
+        // fixed here it would pin the free world to one or two points
+        // (a nearly singular system whose numbers depend on the rounding).
+        continue;
       } else {
         observation.point = correspondence.point3D;
         has_fixed_points_ = true;
       }
       // Blocks are assigned later; remember the owners in the block fields.
       observation.rig_block = image.frameset_index;
+      observation.cluster = image.frameset_index;
       observation.cam_block = c;
       observation.intrinsics_block = c;
       observations_.push_back(observation);
@@ -427,6 +461,8 @@ void UncertaintyProblem::CollectObservations() {
         observation.point = refined->second;
         observation.point_index = point_index(map_observation.point3D_id);
         observation.rig_block = static_cast<int>(m);
+        observation.cluster =
+            static_cast<int>(rig_from_world_.size() + m);
         observation.intrinsics_block = image.camera_index;
         observation.free_intrinsics = &map_free_intrinsics_[image.camera_index];
         observations_.push_back(observation);
@@ -533,8 +569,7 @@ struct alignas(64) UncertaintyProblem::AccumulationChunk {
   int64_t num_used = 0;
   int64_t num_point_parameters = 0;            // ranks of the eliminated points
   std::vector<std::vector<double>> distances;  // per rig camera
-  std::vector<double> j_intrinsics;            // scratch
-  std::vector<std::pair<int, Eigen::MatrixXd>> entries;
+  ObservationJacobian evaluated;               // scratch
 };
 
 int UncertaintyProblem::NumThreads() const {
@@ -544,38 +579,25 @@ int UncertaintyProblem::NumThreads() const {
                         static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-// J^T J of one observation into the chunk's reduced blocks and the terms of
-// its refined point (`point`, null for a fixed one), and its residual
-// statistics (see the header).
-void UncertaintyProblem::AccumulateObservation(const Observation& observation,
-                                               PointTerms* point,
-                                               AccumulationChunk* chunk) const {
+// The residual r = projected - observed of one observation and its Jacobian
+// over the reduced blocks it varies (`entries`: block, 2 x dim in the
+// blocks' tangent spaces) and over its point. False for a point behind its
+// camera (not an inlier of the adjustment).
+bool UncertaintyProblem::EvaluateObservation(const Observation& observation,
+                                             ObservationJacobian* out) const {
   const ceres::CostFunction* cost = costs_.at(observation.model_id).get();
   const int num_params = cost->parameter_block_sizes()[2];
   RowMajor2x7 j_rig, j_cam;
-  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> j_point;
-  chunk->j_intrinsics.resize(2 * num_params);
+  out->j_intrinsics.resize(2 * num_params);
   const double* parameters[4] = {observation.rig_pose, observation.cam_pose,
                                  observation.params, observation.point.data()};
   double* jacobians[4] = {j_rig.data(), j_cam.data(),
-                          chunk->j_intrinsics.data(), j_point.data()};
-  double residual[2];
-  // A point behind its camera is not an inlier of the adjustment.
-  if (!cost->Evaluate(parameters, residual, jacobians)) return;
-  ++chunk->num_used;
-  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
-  const double s = std::pow(residual[0] - observation.observed.x(), 2) +
-                   std::pow(residual[1] - observation.observed.y(), 2);
-  const double u = s / loss_b;
-  chunk->sum_squared += s;
-  chunk->sum_meat += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
-  chunk->sum_bread += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
-  if (observation.rig_camera >= 0) {
-    chunk->distances[observation.rig_camera].push_back(
-        Transform(observation.rig_pose, observation.cam_pose, observation.point)
-            .norm());
-  }
-  std::vector<std::pair<int, Eigen::MatrixXd>>& entries = chunk->entries;
+                          out->j_intrinsics.data(), out->j_point.data()};
+  double projected[2];
+  if (!cost->Evaluate(parameters, projected, jacobians)) return false;
+  out->residual = Eigen::Vector2d(projected[0], projected[1]) -
+                  observation.observed;
+  std::vector<std::pair<int, Eigen::MatrixXd>>& entries = out->entries;
   entries.clear();
   if (observation.rig_block >= 0) {
     entries.emplace_back(observation.rig_block,
@@ -589,11 +611,38 @@ void UncertaintyProblem::AccumulateObservation(const Observation& observation,
     const std::vector<int>& free = *observation.free_intrinsics;
     Eigen::MatrixXd jacobian(2, free.size());
     for (size_t k = 0; k < free.size(); ++k) {
-      jacobian(0, k) = chunk->j_intrinsics[free[k]];
-      jacobian(1, k) = chunk->j_intrinsics[num_params + free[k]];
+      jacobian(0, k) = out->j_intrinsics[free[k]];
+      jacobian(1, k) = out->j_intrinsics[num_params + free[k]];
     }
     entries.emplace_back(observation.intrinsics_block, jacobian);
   }
+  return true;
+}
+
+// J^T J of one observation into the chunk's reduced blocks and the terms of
+// its refined point (`point`, null for a fixed one), and its residual
+// statistics (see the header).
+void UncertaintyProblem::AccumulateObservation(const Observation& observation,
+                                               PointTerms* point,
+                                               AccumulationChunk* chunk) const {
+  ObservationJacobian& evaluated = chunk->evaluated;
+  if (!EvaluateObservation(observation, &evaluated)) return;
+  ++chunk->num_used;
+  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
+  const double s = evaluated.residual.squaredNorm();
+  const double u = s / loss_b;
+  chunk->sum_squared += s;
+  chunk->sum_meat += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
+  chunk->sum_bread += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
+  if (observation.rig_camera >= 0) {
+    chunk->distances[observation.rig_camera].push_back(
+        Transform(observation.rig_pose, observation.cam_pose, observation.point)
+            .norm());
+  }
+  const std::vector<std::pair<int, Eigen::MatrixXd>>& entries =
+      evaluated.entries;
+  const Eigen::Matrix<double, 2, 3, Eigen::RowMajor>& j_point =
+      evaluated.j_point;
   for (size_t i = 0; i < entries.size(); ++i) {
     for (size_t j = i; j < entries.size(); ++j) {
       chunk->reduced->Add(entries[i].first, entries[j].first,
@@ -892,16 +941,101 @@ void UncertaintyProblem::AnchorScale() {
   if (num_o_ > 0) v.head(num_o_) = y_o - x_oc_ * v_c;
   v.tail(num_c_) = v_c;
   double a_v = a_o.dot(v.head(num_o_));
+  anchor_v_points_.assign(points_.size(), Eigen::Vector3d::Zero());
   for (size_t p = 0; p < points_.size(); ++p) {
     Eigen::Vector3d residual = a_points[p];
     for (const auto& [block, cross] : points_[p].cross) {
       residual -= cross * v.segment(blocks_[block].offset, blocks_[block].dim);
     }
-    a_v += a_points[p].dot(points_[p].pseudo_inverse * residual);
+    anchor_v_points_[p] = points_[p].pseudo_inverse * residual;
+    a_v += a_points[p].dot(anchor_v_points_[p]);
   }
+  anchor_v_ = v;
   const Eigen::VectorXd& n = scale_direction_c_;
   covariance_c_ +=
       -n * v_c.transpose() - v_c * n.transpose() + a_v * n * n.transpose();
+}
+
+// The between-framesets covariance over C (see the header): per cluster g
+// (a frameset's rig images, or one map image) its score
+//   s_g = sum_{k in g} rho'(s_k) J_k^T r_k
+// over every free parameter, its influence d_g = (J^T J)^-1 s_g / mean(rho'
+// + s rho'') on C by the same elimination as the covariance (points by
+// their 3x3 blocks, then O through R_OO^-1 R_OC = x_oc_, then the gauge as
+// held by the priors), the anchoring's scale taken out as in AnchorScale
+// (d_C - n_C a^T d, a^T d = anchor_v_^T s_g), and
+//   Cov_between = G/(G-1) sum_g d_g d_g^T.
+// `unanchored`: the covariance over C before AnchorScale. The clusters run
+// on all threads, each into its own d_g, summed in cluster order.
+void UncertaintyProblem::BetweenFramesetsCovariance(
+    const Eigen::MatrixXd& unanchored) {
+  const int num_clusters =
+      static_cast<int>(rig_from_world_.size() + map_cam_from_world_.size());
+  std::vector<std::vector<int>> by_cluster(num_clusters);
+  for (size_t o = 0; o < observations_.size(); ++o) {
+    by_cluster[observations_[o].cluster].push_back(static_cast<int>(o));
+  }
+  std::vector<int> clusters;
+  for (int g = 0; g < num_clusters; ++g) {
+    if (!by_cluster[g].empty()) clusters.push_back(g);
+  }
+  const int num_used = static_cast<int>(clusters.size());
+  const double n = static_cast<double>(num_residuals_ / 2);
+  const double mean_bread = sum_bread_ / n;
+  if (num_used < kMinNumClusters || !(mean_bread > 0)) return;
+  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
+  const bool anchored = anchor_v_.size() == num_o_ + num_c_;
+  std::vector<Eigen::VectorXd> influences(num_used);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+  for (int g = 0; g < num_used; ++g) {
+    Eigen::VectorXd score = Eigen::VectorXd::Zero(num_o_ + num_c_);
+    std::vector<std::pair<int, Eigen::Vector3d>> point_scores;
+    ObservationJacobian evaluated;
+    for (const int o : by_cluster[clusters[g]]) {
+      const Observation& observation = observations_[o];
+      if (!EvaluateObservation(observation, &evaluated)) continue;
+      const double u = evaluated.residual.squaredNorm() / loss_b;
+      const Eigen::Vector2d weighted = evaluated.residual / (1 + u);
+      for (const auto& [block, jacobian] : evaluated.entries) {
+        score.segment(blocks_[block].offset, blocks_[block].dim) +=
+            jacobian.transpose() * weighted;
+      }
+      if (observation.point_index >= 0) {
+        point_scores.emplace_back(observation.point_index,
+                                  evaluated.j_point.transpose() * weighted);
+      }
+    }
+    double anchor = anchored ? anchor_v_.dot(score) : 0;
+    Eigen::VectorXd reduced = score;
+    std::stable_sort(
+        point_scores.begin(), point_scores.end(),
+        [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t k = 0; k < point_scores.size();) {
+      const int p = point_scores[k].first;
+      Eigen::Vector3d point_score = Eigen::Vector3d::Zero();
+      for (; k < point_scores.size() && point_scores[k].first == p; ++k) {
+        point_score += point_scores[k].second;
+      }
+      const Eigen::Vector3d solved = points_[p].pseudo_inverse * point_score;
+      for (const auto& [block, cross] : points_[p].cross) {
+        reduced.segment(blocks_[block].offset, blocks_[block].dim) -=
+            cross.transpose() * solved;
+      }
+      if (anchored) anchor += anchor_v_points_[p].dot(point_score);
+    }
+    Eigen::VectorXd rhs_c = reduced.tail(num_c_);
+    if (num_o_ > 0) rhs_c -= x_oc_.transpose() * reduced.head(num_o_);
+    Eigen::VectorXd influence = unanchored * rhs_c;
+    if (anchored) influence -= anchor * scale_direction_c_;
+    influences[g] = influence / mean_bread;
+  }
+  cluster_covariance_c_ = Eigen::MatrixXd::Zero(num_c_, num_c_);
+  for (const Eigen::VectorXd& influence : influences) {
+    cluster_covariance_c_.selfadjointView<Eigen::Lower>().rankUpdate(influence);
+  }
+  cluster_covariance_c_ = cluster_covariance_c_.selfadjointView<Eigen::Lower>();
+  cluster_covariance_c_ *= static_cast<double>(num_used) / (num_used - 1);
+  num_clusters_ = num_used;
 }
 
 void UncertaintyProblem::FillProjection(int camera_index,
@@ -918,8 +1052,6 @@ void UncertaintyProblem::FillProjection(int camera_index,
   projection.stddev_px.assign(projection.cols * projection.rows, kNaN);
   ceres::CostFunction* cost = CostFor(camera.ModelId());
   const int num_params = static_cast<int>(camera.NumParams());
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>& covariance =
-      uncertainty->covariance;
   const Rigid3d& cam_from_rig = calibration_.cam_from_rig[camera_index];
   const Rigid3d rig_from_cam = cam_from_rig.Inverse();
   const PoseArray& cam_pose = cam_from_rig_[camera_index];
@@ -953,12 +1085,23 @@ void UncertaintyProblem::FillProjection(int camera_index,
         jacobian(1, k) = j_intrinsics[num_params + k];
       }
       jacobian.rightCols<6>() = PoseTangentJacobian(j_cam, cam_pose.data());
-      const Eigen::Matrix2d pixel_covariance =
-          jacobian * covariance * jacobian.transpose();
-      const double stddev = std::sqrt(std::max(
-          0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(pixel_covariance)
-                   .eigenvalues()
-                   .maxCoeff()));
+      // The larger of the two estimates (see the header), each in its
+      // worst direction.
+      double stddev = 0;
+      for (const Eigen::MatrixXd* matrix :
+           {&uncertainty->covariance,
+            &uncertainty->between_framesets_covariance}) {
+        if (matrix->rows() != num_params + 6) continue;
+        const Eigen::Matrix2d pixel_covariance =
+            jacobian * *matrix * jacobian.transpose();
+        stddev = std::max(
+            stddev,
+            std::sqrt(std::max(
+                0.0,
+                Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(pixel_covariance)
+                    .eigenvalues()
+                    .maxCoeff())));
+      }
       projection.stddev_px[row * projection.cols + col] = stddev;
       values.push_back(stddev);
       if (stddev > projection.max_px || values.size() == 1) {
@@ -974,6 +1117,7 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
                                      CalibrationUncertainty* result) const {
   const double variance =
       result->effective_scale_px * result->effective_scale_px;
+  const bool between = cluster_covariance_c_.rows() == num_c_ && num_c_ > 0;
   result->cameras.assign(calibration_.cameras.size(), CameraUncertainty());
   for (size_t c = 0; c < calibration_.cameras.size(); ++c) {
     if (distances_[c].empty()) continue;  // not in the adjustment
@@ -995,6 +1139,9 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
     }
     const int size = num_params + 6;
     camera.covariance = Eigen::MatrixXd::Zero(size, size);
+    if (between) {
+      camera.between_framesets_covariance = Eigen::MatrixXd::Zero(size, size);
+    }
     std::vector<char> undetermined(size, 0);
     camera.determined = true;
     for (int i = 0; i < size; ++i) {
@@ -1002,22 +1149,42 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
       undetermined[i] = undetermined_c_[index[i]];
       camera.determined = camera.determined && !undetermined[i];
       for (int j = 0; j < size; ++j) {
-        if (index[j] >= 0) {
-          camera.covariance(i, j) =
-              variance * covariance_c_(index[i], index[j]);
+        if (index[j] < 0) continue;
+        camera.covariance(i, j) = variance * covariance_c_(index[i], index[j]);
+        if (between) {
+          camera.between_framesets_covariance(i, j) =
+              cluster_covariance_c_(index[i], index[j]);
         }
       }
     }
-    const auto stddev = [&](int i) {
-      return undetermined[i]
-                 ? kNaN
-                 : std::sqrt(std::max(0.0, camera.covariance(i, i)));
+    // The reported standard deviation of a linear function v^T x of [params,
+    // w, t]: the larger of the two estimates (see the header).
+    const auto larger = [&](const Eigen::MatrixXd& v) {
+      double value = (v.transpose() * camera.covariance * v).trace();
+      if (between) {
+        value = std::max(
+            value,
+            (v.transpose() * camera.between_framesets_covariance * v).trace());
+      }
+      return std::sqrt(std::max(0.0, value));
     };
+    const auto stddev = [&](int i) {
+      if (undetermined[i]) return kNaN;
+      return larger(Eigen::VectorXd::Unit(size, i));
+    };
+    for (int k = 0; k < size; ++k) {
+      if (!between || index[k] < 0 || undetermined[k]) continue;
+      const double noise = std::sqrt(std::max(0.0, camera.covariance(k, k)));
+      const double spread = std::sqrt(
+          std::max(0.0, camera.between_framesets_covariance(k, k)));
+      if (noise > 0) {
+        camera.between_framesets_factor =
+            std::max(camera.between_framesets_factor, spread / noise);
+      }
+    }
     for (int k = 0; k < num_params; ++k) {
       camera.params_stddev.push_back(stddev(k));
     }
-    const Eigen::Matrix<double, 6, 6> extrinsics =
-        camera.covariance.bottomRightCorner<6, 6>();
     const bool extrinsics_determined =
         std::none_of(undetermined.end() - 6, undetermined.end(),
                      [](char u) { return u != 0; });
@@ -1026,20 +1193,18 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
       camera.rotation_axis_stddev_deg(k) = to_deg * stddev(num_params + k);
       camera.translation_stddev(k) = stddev(num_params + 3 + k);
     }
+    // sqrt(trace Cov_w): the rotation rows of [params, w, t].
+    Eigen::MatrixXd rotation_rows = Eigen::MatrixXd::Zero(size, 3);
+    rotation_rows.block<3, 3>(num_params, 0).setIdentity();
     camera.rotation_stddev_deg =
-        extrinsics_determined
-            ? to_deg * std::sqrt(std::max(
-                           0.0, extrinsics.topLeftCorner<3, 3>().trace()))
-            : kNaN;
+        extrinsics_determined ? to_deg * larger(rotation_rows) : kNaN;
     const Eigen::Matrix<double, 3, 6> center_jacobian =
         CenterJacobian(calibration_.cam_from_rig[c]);
-    const Eigen::Matrix3d center_covariance =
-        center_jacobian * extrinsics * center_jacobian.transpose();
     for (int k = 0; k < 3; ++k) {
+      Eigen::VectorXd row = Eigen::VectorXd::Zero(size);
+      row.tail<6>() = center_jacobian.row(k).transpose();
       camera.center_in_rig_stddev(k) =
-          extrinsics_determined
-              ? std::sqrt(std::max(0.0, center_covariance(k, k)))
-              : kNaN;
+          extrinsics_determined ? larger(row) : kNaN;
     }
     if (camera.determined)
       FillProjection(static_cast<int>(c), options, &camera);
@@ -1073,8 +1238,19 @@ std::string UncertaintyProblem::Method() const {
            << (options_.refine_points ? "fixed map points or map image poses"
                                       : "fixed map points");
   }
-  method << "; assumes independent Gaussian pixel noise of one level for all "
-            "observations and exact fixed points and poses";
+  if (num_clusters_ > 0) {
+    method << "; every standard deviation is the larger of that and the "
+              "between-framesets covariance (cluster-robust sandwich over "
+           << num_clusters_
+           << " framesets and map images), which covers per-camera noise "
+              "levels and errors shared within a frameset or image; neither "
+              "covers errors every frameset shares (a fixed map's bias, a "
+              "lens the model cannot follow)";
+  } else {
+    method << "; assumes independent Gaussian pixel noise of one level for "
+              "all observations (fewer than 3 framesets and map images: no "
+              "between-framesets estimate)";
+  }
   return method.str();
 }
 
@@ -1109,7 +1285,11 @@ bool UncertaintyProblem::Run(const UncertaintyOptions& options,
       std::sqrt(dof * (sum_meat_ / n) / std::pow(sum_bread_ / n, 2));
   AddGaugePriors();
   if (!Marginalize(result)) return false;
+  const Eigen::MatrixXd unanchored = covariance_c_;
   if (free_gauge_) AnchorScale();
+  BetweenFramesetsCovariance(unanchored);
+  result->num_clusters = num_clusters_;
+  result->method = Method();
   FillCameras(options, result);
   return true;
 }

@@ -223,11 +223,16 @@ bool SyntheticRigOptions::Check(std::string* error) const {
   } else if (!(feature_window > 0 && feature_window <= 1)) {
     message << "feature_window must be in (0, 1], got " << feature_window;
   } else if (num_map_images < 0 || !(map_noise_px >= 0) ||
-             !(map_point_noise >= 0)) {
-    message << "num_map_images, map_noise_px and map_point_noise must be "
-               ">= 0, got "
+             !(map_point_noise >= 0) || !(map_pose_noise_deg >= 0) ||
+             !(map_pose_noise >= 0) || !std::isfinite(map_drift_deg) ||
+             !(std::abs(map_scale_drift) < 0.5)) {
+    message << "num_map_images, map_noise_px, map_point_noise, "
+               "map_pose_noise_deg and map_pose_noise must be >= 0, "
+               "map_drift_deg finite and |map_scale_drift| < 0.5, got "
             << num_map_images << ", " << map_noise_px << ", "
-            << map_point_noise;
+            << map_point_noise << ", " << map_pose_noise_deg << ", "
+            << map_pose_noise << ", " << map_drift_deg << ", "
+            << map_scale_drift;
   } else {
     return true;
   }

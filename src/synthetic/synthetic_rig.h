@@ -90,6 +90,23 @@ struct SyntheticRigOptions {
   int num_map_images = 0;
   double map_noise_px = 0.5;
   double map_point_noise = 0.0;
+  // A map as structure from motion makes it (with num_map_images > 0): the
+  // map images' poses given to the calibration are off by
+  // map_pose_noise_deg (rotation, degrees per axis) and map_pose_noise
+  // (centre, map units per axis), Gaussian and independent per image, plus
+  // a drift that grows linearly along the map images to map_drift_deg (a
+  // rotation about the vertical through the first rig centre) and
+  // map_scale_drift (relative scale about that centre) at the last one;
+  // with triangulate_map_points every map point that >= 2 map images
+  // observe is triangulated from their noisy observations through those
+  // poses (so its error follows theirs, as in a real map), the others keep
+  // map_point_noise. The correspondences and map_points3D carry the map's
+  // points; the rig images observe the true ones.
+  double map_pose_noise_deg = 0.0;
+  double map_pose_noise = 0.0;
+  double map_drift_deg = 0.0;
+  double map_scale_drift = 0.0;
+  bool triangulate_map_points = false;
   // stereo_pair only: that many copies of the pair, copy k 0.25 k m above
   // the first (several pairs facing the same way: all principal axes
   // parallel); with stereo_alternate_facing the odd copies face backward,

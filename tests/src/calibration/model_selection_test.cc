@@ -242,6 +242,43 @@ TEST(ModelSelection, FewFramesetsWideFisheyeGetsOpenCVFisheye) {
   EXPECT_LT(mean_px, 0.2);
 }
 
+TEST(ModelSelection, FewFramesetsWithNoCandidateFollowingTheLensStillCalibrates) {
+  // 4 framesets of a narrow lens whose image radius ripples by 2 px with a
+  // 150 px period: neither OPENCV nor OPENCV_FISHEYE follows it (OPENCV
+  // fails the ring check, OPENCV_FISHEYE folds). Before, the camera was left
+  // uncalibrated; now it is calibrated with the candidate valid over the
+  // image that misfits least, the choice marked uncertain, its projection
+  // within the ripple of the truth.
+  const colmap::Camera truth =
+      MakeCamera("OPENCV", 752, 480,
+                 {458.654, 457.296, 367.215, 248.375, -0.28340811, 0.07395907,
+                  0.00019359, 1.76187114e-05});
+  Data data = MakeData(truth, 0.0, 3000, 0.3, 0, 10, /*num_groups=*/4);
+  const Eigen::Vector2d pp(truth.PrincipalPointX(), truth.PrincipalPointY());
+  for (Eigen::Vector2d& point : data.points2D) {
+    const Eigen::Vector2d offset = point - pp;
+    const double radius = offset.norm();
+    if (radius > 1) {
+      point += 2.0 * std::sin(2 * M_PI * radius / 150) * offset / radius;
+    }
+  }
+  const Selected selected = Select(truth, data);
+  ASSERT_TRUE(selected.success) << selected.result.error_message;
+  EXPECT_TRUE(selected.choice.uncertain);
+  ASSERT_EQ(selected.choice.candidates.size(), 2u);
+  EXPECT_FALSE(Candidate(selected.choice, "OPENCV").valid);
+  EXPECT_FALSE(Candidate(selected.choice, "OPENCV_FISHEYE").valid);
+  EXPECT_TRUE(selected.choice.chosen == "OPENCV" ||
+              selected.choice.chosen == "OPENCV_FISHEYE");
+  EXPECT_NE(selected.choice.reason.find("not sure"), std::string::npos);
+  double mean_px, max_px;
+  ProjectionDifference(truth, selected.camera, &mean_px, &max_px);
+  std::cout << "rippled lens: " << selected.choice.chosen
+            << " mean/max projection error " << mean_px << "/" << max_px
+            << " px" << std::endl;
+  EXPECT_LT(mean_px, 2.5);
+}
+
 TEST(ModelSelection, CandidatesOnASubsetWinnerOnAllRows) {
   // 1500 of 4000 rows compare the candidates; the winner is fitted to all
   // 4000 (its inlier mask covers them) and is exact.

@@ -190,6 +190,56 @@ TEST(CalibrationUncertainty, ExactDataGiveZeroSigmaAndNoNaN) {
   }
 }
 
+// With the map adjusted, a rig correspondence of a point that no map image
+// and no other rig image sees is held by the adjustment but carries no
+// information. Taken as a fixed point it pinned the free world to that one
+// point (7 gauge directions, 3 pinned): a singular system and no
+// uncertainty, as on a real map (infrascal_ring, 10 held-out timestamps).
+TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
+  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
+  options.num_map_images = 24;
+  options.outlier_ratio = 0;
+  SyntheticRig rig = GenerateSyntheticRig(options);
+  KeepPointsWithTracks(&rig);
+  const FinalBundleAdjustmentOptions ba = MapAdjustment();
+  RigCalibration calibration = StartAtTruth(rig);
+  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
+  const CalibrationUncertainty reference =
+      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
+  ASSERT_TRUE(reference.computed) << reference.message;
+
+  // One more correspondence in the first image: a point of its own, exact.
+  RigImage& image = rig.dataset.images[0];
+  const Rigid3d cam_from_world =
+      rig.truth.cam_from_rig[image.camera_index] *
+      rig.truth.rig_from_world[image.frameset_index];
+  Correspondence once;
+  once.point3D = cam_from_world.Inverse() * Eigen::Vector3d(0.1, -0.2, 4.0);
+  once.point2D = rig.truth.cameras[image.camera_index].WorldToImage(
+      Eigen::Vector2d(0.1 / 4.0, -0.2 / 4.0));
+  once.point3D_id = 1000000;
+  image.correspondences.push_back(once);
+  calibration = StartAtTruth(rig);
+  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
+  ASSERT_EQ(calibration.refined_points3D.count(once.point3D_id), 0u);
+  const CalibrationUncertainty uncertainty =
+      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
+  ASSERT_TRUE(uncertainty.computed) << uncertainty.message;
+  EXPECT_TRUE(uncertainty.free_gauge);
+  for (size_t c = 0; c < uncertainty.cameras.size(); ++c) {
+    const CameraUncertainty& camera = uncertainty.cameras[c];
+    ASSERT_TRUE(camera.computed && camera.determined);
+    EXPECT_TRUE(AllFinite(camera));
+    // The same data but one uninformative observation: the same sigma.
+    EXPECT_NEAR(camera.rotation_stddev_deg,
+                reference.cameras[c].rotation_stddev_deg,
+                0.05 * reference.cameras[c].rotation_stddev_deg + 1e-9);
+    EXPECT_NEAR(camera.center_in_rig_stddev.norm(),
+                reference.cameras[c].center_in_rig_stddev.norm(),
+                0.05 * reference.cameras[c].center_in_rig_stddev.norm() + 1e-9);
+  }
+}
+
 TEST(CalibrationUncertainty, ResultDoesNotDependOnThreadCount) {
   SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
   options.num_map_images = 24;

@@ -147,6 +147,129 @@ TEST(RadialResidualProfile, BiasInOneRangeOfRadiiIsFound) {
   EXPECT_NE(DescribeRadialMisfit(profile).find("inwards"), std::string::npos);
 }
 
+// `num_images` images of `per_image` points each (as MakeObservations, 0.5
+// px noise), image i with its own radial scale error scale(i): a residual
+// scale(i) * r, as a map's per-image pose or depth error leaves it.
+template <typename Scale>
+void MakeImageObservations(const int num_images, const int per_image,
+                           const Scale& scale, const unsigned seed,
+                           std::vector<Eigen::Vector2d>* observed,
+                           std::vector<Eigen::Vector2d>* projected,
+                           std::vector<int>* images) {
+  observed->clear();
+  projected->clear();
+  images->clear();
+  for (int i = 0; i < num_images; ++i) {
+    std::vector<Eigen::Vector2d> image_observed, image_projected;
+    const double s = scale(i);
+    MakeObservations(
+        per_image, 0.5, [s](double r) { return s * r; }, seed * 1000 + i,
+        &image_observed, &image_projected);
+    observed->insert(observed->end(), image_observed.begin(),
+                     image_observed.end());
+    projected->insert(projected->end(), image_projected.begin(),
+                      image_projected.end());
+    images->insert(images->end(), per_image, i);
+  }
+}
+
+TEST(RadialResidualProfile, ErrorsSharedWithinImagesAreNotSystematic) {
+  // 12 images x 600 points, each image 0.6 % off in scale at random (1.7 px
+  // at 280 px): the rings' means wander by ~0.5 px, which the per-point
+  // standard error (no groups) calls 5-10 standard errors on most seeds,
+  // and the image-clustered one sees as the images' spread.
+  int flagged_by_point = 0, flagged_by_image = 0;
+  double sum_squared_z = 0;
+  int num_rings = 0;
+  for (unsigned seed = 0; seed < 40; ++seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> scale_error(0, 0.006);
+    std::vector<double> scales;
+    for (int i = 0; i < 12; ++i) scales.push_back(scale_error(rng));
+    std::vector<Eigen::Vector2d> observed, projected;
+    std::vector<int> images;
+    MakeImageObservations(
+        12, 600, [&](int i) { return scales[i]; }, seed + 1, &observed,
+        &projected, &images);
+    flagged_by_point +=
+        ComputeRadialResidualProfile(kPrincipalPoint, observed, projected)
+            .systematic;
+    const RadialResidualProfile profile = ComputeRadialResidualProfile(
+        kPrincipalPoint, observed, projected, images);
+    flagged_by_image += profile.systematic;
+    for (const RadialResidualRing& ring : profile.rings) {
+      EXPECT_EQ(ring.num_groups, 12);
+      EXPECT_NEAR(ring.z_threshold, 6.24, 0.01);  // t_11 at the normal 4-sigma tail
+      sum_squared_z += ring.z * ring.z;
+      ++num_rings;
+    }
+  }
+  std::cout << "errors shared within images: " << flagged_by_point
+            << " of 40 systematic by point, " << flagged_by_image
+            << " by image; RMS z by image "
+            << std::sqrt(sum_squared_z / num_rings) << std::endl;
+  EXPECT_GE(flagged_by_point, 20);
+  EXPECT_EQ(flagged_by_image, 0);
+}
+
+TEST(RadialResidualProfile, BiasSharedByEveryImageIsSystematic) {
+  // Every image 0.4 % off the same way (+- 0.05 %): a model error, found
+  // with the image-clustered standard error too.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> scale_error(0.004, 0.0005);
+  std::vector<double> scales;
+  for (int i = 0; i < 12; ++i) scales.push_back(scale_error(rng));
+  std::vector<Eigen::Vector2d> observed, projected;
+  std::vector<int> images;
+  MakeImageObservations(
+      12, 600, [&](int i) { return scales[i]; }, 11, &observed, &projected,
+      &images);
+  const RadialResidualProfile profile =
+      ComputeRadialResidualProfile(kPrincipalPoint, observed, projected, images);
+  ASSERT_TRUE(profile.systematic);
+  const RadialResidualRing& worst = profile.rings[profile.worst_ring];
+  EXPECT_GT(worst.mean_radial_px, 0.25);
+  EXPECT_GT(worst.z, worst.z_threshold);
+  EXPECT_EQ(worst.num_groups, 12);
+}
+
+TEST(RadialResidualProfile, BiasAtTheMapsOwnLevelIsNotSystematic) {
+  // Every image 0.2 % off the same way (0.5-0.6 px in the outer rings):
+  // systematic on its own; with the map's own systematic level at 0.6 px
+  // (camera_model_stage.h) it does not exceed it and is not; with the level
+  // at 0.3 px it exceeds it by many standard errors and is again.
+  std::mt19937 rng(6);
+  std::normal_distribution<double> scale_error(0.002, 0.0001);
+  std::vector<double> scales;
+  for (int i = 0; i < 12; ++i) scales.push_back(scale_error(rng));
+  std::vector<Eigen::Vector2d> observed, projected;
+  std::vector<int> images;
+  MakeImageObservations(
+      12, 600, [&](int i) { return scales[i]; }, 13, &observed, &projected,
+      &images);
+  RadialResidualProfileOptions options;
+  EXPECT_TRUE(ComputeRadialResidualProfile(kPrincipalPoint, observed,
+                                           projected, images, options)
+                  .systematic);
+  options.systematic_floor_px = 0.6;
+  const RadialResidualProfile at_floor = ComputeRadialResidualProfile(
+      kPrincipalPoint, observed, projected, images, options);
+  EXPECT_FALSE(at_floor.systematic);
+  EXPECT_EQ(at_floor.systematic_floor_px, 0.6);
+  options.systematic_floor_px = 0.3;
+  EXPECT_TRUE(ComputeRadialResidualProfile(kPrincipalPoint, observed,
+                                           projected, images, options)
+                  .systematic);
+}
+
+TEST(RadialResidualProfile, StudentThresholdMatchesTheNormalTail) {
+  // Many degrees of freedom: the normal's 5; 11: t_11 at 2.9e-7 one-sided.
+  EXPECT_NEAR(StudentThresholdLikeNormal(5, 100000), 5.0, 1e-3);
+  EXPECT_NEAR(StudentThresholdLikeNormal(1.959964, 10), 2.228139, 1e-4);
+  EXPECT_GT(StudentThresholdLikeNormal(5, 11), 10);
+  EXPECT_TRUE(std::isinf(StudentThresholdLikeNormal(5, 0)));
+}
+
 TEST(RadialResidualProfile, BiasBelowTheFloorIsNotSystematic) {
   // 0.1 px outwards everywhere with 10^5 points: z is large (~40), the bias
   // below min_bias_px.
