@@ -353,12 +353,19 @@ def compare_command(args):
     # The warnings and errors that name each camera.
     # The summary's diagnostics are lines "<level> <code>: <text>"; a
     # camera is named by the text ("cam1: ..." or "camera cam1: ...").
+    # A warning that names no camera (e.g. "the uncertainty could not be
+    # computed") flags every camera.
     flags = {}
     names = [c.get("name") for c in summary.get("cameras", [])]
     for diagnostic in summary.get("diagnostics", []):
         match = re.match(r"(\w+) (\w+): (?:camera )?([^ :]+):", diagnostic)
         if match and match.group(3) in names:
             flags.setdefault(match.group(3), []).append(match.group(2))
+            continue
+        match = re.match(r"(\w+) (\w+):", diagnostic)
+        if match and match.group(1) in ("warning", "error"):
+            for name in names:
+                flags.setdefault(name, []).append(match.group(2))
     out_rows = []
     print("  %-5s %-15s %7s %7s %7s %5s | %7s %7s %7s %5s | %6s %6s %5s | %6s %6s | %s"
           % ("cam", "model", "rot_err", "rot_sig", "rot_ref", "z",
@@ -426,7 +433,7 @@ def compare_command(args):
         worst = max(zs) if zs and not any(math.isnan(z) for z in zs) \
             else float("nan")
         row["worst_z"] = worst
-        if worst <= 3:
+        if not math.isnan(worst) and worst <= 3:
             row["verdict"] = "within 3 sigma"
         elif row["flags"]:
             row["verdict"] = "flagged"
@@ -468,12 +475,13 @@ def verdicts_command(args):
         counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
     print("  %d cameras: %s" % (len(rows), ", ".join(
         "%d %s" % (n, v) for v, n in sorted(counts.items()))))
-    zs = [r["rotation_z"] for r in rows if "rotation_z" in r] + \
-        [r["center_z"] for r in rows if "center_z" in r]
+    zs = [r[key] for r in rows for key in ("rotation_z", "center_z")
+          if key in r and not math.isnan(r[key])]
     if zs:
-        print("  rotation and centre |error|/sigma: median %.2f, max %.2f, "
-              "%d of %d within 3" % (float(np.median(zs)), max(zs),
-                                     sum(z <= 3 for z in zs), len(zs)))
+        print("  rotation and centre |error|/sigma (where sigma was computed): "
+              "median %.2f, max %.2f, %d of %d within 3"
+              % (float(np.median(zs)), max(zs), sum(z <= 3 for z in zs),
+                 len(zs)))
     for r in bad:
         print("  %s %s: %s" % (r["label"], r["camera"], r["verdict"]))
     sys.exit(1 if bad else 0)

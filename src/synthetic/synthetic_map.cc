@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <random>
+#include <unordered_map>
 
 #include "src/synthetic/correspondence_generator.h"
 
@@ -202,6 +203,25 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
     TriangulateMapPoints(dataset, &map_points);
   }
   give_map_points();
+}
+
+void KeepCorrespondencesWithMapTracks(SyntheticRig* rig) {
+  if (rig->dataset.map_images.empty()) return;
+  std::unordered_map<int64_t, int> num_observations;
+  for (const MapImage& image : rig->dataset.map_images) {
+    for (const MapObservation& observation : image.observations) {
+      ++num_observations[observation.point3D_id];
+    }
+  }
+  for (RigImage& image : rig->dataset.images) {
+    std::vector<Correspondence> kept;
+    for (const Correspondence& correspondence : image.correspondences) {
+      if (num_observations[correspondence.point3D_id] >= 2) {
+        kept.push_back(correspondence);
+      }
+    }
+    image.correspondences = kept;
+  }
 }
 
 }  // namespace rig_calibrator

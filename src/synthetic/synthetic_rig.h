@@ -146,6 +146,12 @@ struct SyntheticRig {
 // rig without images.
 SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options);
 
+// Keeps the rig correspondences of points that at least two map images
+// observe, as in a COLMAP map, where every point has a track (with map
+// images; without, nothing changes): then every point can be refined with
+// the map, and the map adjustment's gauge is free.
+void KeepCorrespondencesWithMapTracks(SyntheticRig* rig);
+
 // The sub-problem made of the given framesets (indices into rig, in the given
 // order, renumbered from 0; names kept), e.g. for the short-sequence
 // robustness experiments (paper section 5.3: 10 framesets). Indices out of

@@ -52,26 +52,6 @@ struct Group {
   }
 };
 
-// A COLMAP map keeps only points with a track: the rig's correspondences
-// of points that fewer than 2 map images observe are dropped.
-void KeepPointsWithTracks(SyntheticRig* rig) {
-  std::map<int64_t, int> num_observations;
-  for (const MapImage& image : rig->dataset.map_images) {
-    for (const MapObservation& observation : image.observations) {
-      ++num_observations[observation.point3D_id];
-    }
-  }
-  for (RigImage& image : rig->dataset.images) {
-    std::vector<Correspondence> kept;
-    for (const Correspondence& correspondence : image.correspondences) {
-      if (num_observations[correspondence.point3D_id] >= 2) {
-        kept.push_back(correspondence);
-      }
-    }
-    image.correspondences = kept;
-  }
-}
-
 SyntheticRigOptions MapLikeSfM(unsigned seed) {
   SyntheticRigOptions options;
   options.preset = RigPreset::kRing5;
@@ -115,7 +95,7 @@ TEST(DefaultOptionsSigma, ErrorsOverSigmaOnMapsLikeSfM) {
   std::map<std::string, int> chosen;
   for (int run = 0; run < num_runs; ++run) {
     SyntheticRig rig = GenerateSyntheticRig(MapLikeSfM(500 + run));
-    KeepPointsWithTracks(&rig);
+    KeepCorrespondencesWithMapTracks(&rig);
     // As the command loads a camera whose model is auto.
     for (RigCamera& camera : rig.dataset.cameras) {
       const int width = static_cast<int>(camera.camera.Width());

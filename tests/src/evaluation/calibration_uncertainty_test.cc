@@ -51,28 +51,6 @@ RigCalibration StartAtTruth(const SyntheticRig& rig) {
   return calibration;
 }
 
-// Keeps the rig correspondences of points that at least two map images
-// observe, as in a COLMAP map, where every point has a track: then every
-// point is refined, nothing holds the world frame, and the map adjustment's
-// gauge is free (anchored to the map's camera centres).
-void KeepPointsWithTracks(SyntheticRig* rig) {
-  std::map<int64_t, int> num_observations;
-  for (const MapImage& image : rig->dataset.map_images) {
-    for (const MapObservation& observation : image.observations) {
-      ++num_observations[observation.point3D_id];
-    }
-  }
-  for (RigImage& image : rig->dataset.images) {
-    std::vector<Correspondence> kept;
-    for (const Correspondence& correspondence : image.correspondences) {
-      if (num_observations[correspondence.point3D_id] >= 2) {
-        kept.push_back(correspondence);
-      }
-    }
-    image.correspondences = kept;
-  }
-}
-
 FinalBundleAdjustmentOptions QuietAdjustment() {
   FinalBundleAdjustmentOptions options;
   options.num_threads = 1;
@@ -168,7 +146,7 @@ TEST(CalibrationUncertainty, ExactDataGiveZeroSigmaAndNoNaN) {
     options.map_noise_px = 0;
     if (with_map) options.num_map_images = 24;
     SyntheticRig rig = GenerateSyntheticRig(options);
-    if (with_map) KeepPointsWithTracks(&rig);
+    if (with_map) KeepCorrespondencesWithMapTracks(&rig);
     const FinalBundleAdjustmentOptions ba =
         with_map ? MapAdjustment() : QuietAdjustment();
     RigCalibration calibration = StartAtTruth(rig);
@@ -200,7 +178,7 @@ TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
   options.num_map_images = 24;
   options.outlier_ratio = 0;
   SyntheticRig rig = GenerateSyntheticRig(options);
-  KeepPointsWithTracks(&rig);
+  KeepCorrespondencesWithMapTracks(&rig);
   const FinalBundleAdjustmentOptions ba = MapAdjustment();
   RigCalibration calibration = StartAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
@@ -244,7 +222,7 @@ TEST(CalibrationUncertainty, ResultDoesNotDependOnThreadCount) {
   SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
   options.num_map_images = 24;
   SyntheticRig rig = GenerateSyntheticRig(options);
-  KeepPointsWithTracks(&rig);
+  KeepCorrespondencesWithMapTracks(&rig);
   FinalBundleAdjustmentOptions ba = MapAdjustment();
   RigCalibration calibration = StartAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
@@ -388,11 +366,11 @@ TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
 // inlier. Exact map points held fixed (the covariance has no term for a map
 // error it cannot see), or the default workflow with a map: 24 map images
 // with 0.5 px noise, map points 5 cm off, each seen by two map images or
-// more (KeepPointsWithTracks), refined with the map and the rig (free gauge:
+// more (KeepCorrespondencesWithMapTracks), refined with the map and the rig (free gauge:
 // the scale comes from the map's camera centres), without wrong matches
 // (with 20 % of them, the adjustment of seed 102 fails: a wrong match pulls
 // a refined point behind a camera and Ceres stops on invalid steps).
-TEST(CalibrationUncertainty, NormalizedErrorsSpreadAsTheyShould) {
+TEST(CalibrationUncertainty, NormalizedErrorsSpreadAsTheyShouldFromTheTruth) {
   struct Scenario {
     std::string name;
     RigPreset preset;
@@ -421,7 +399,7 @@ TEST(CalibrationUncertainty, NormalizedErrorsSpreadAsTheyShould) {
         ba = MapAdjustment();
       }
       SyntheticRig rig = GenerateSyntheticRig(options);
-      if (scenario.with_map) KeepPointsWithTracks(&rig);
+      if (scenario.with_map) KeepCorrespondencesWithMapTracks(&rig);
       RigCalibration calibration = StartAtTruth(rig);
       ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr))
           << scenario.name << " seed " << options.seed;
