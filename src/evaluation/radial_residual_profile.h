@@ -37,7 +37,7 @@
 // of freedom (a normal when G is large); the threshold is the t quantile of
 // the same two-sided tail probability as min_z standard deviations of a
 // normal (min_z = 4: 6.3e-5 per ring, false alarms below 1e-3 per camera),
-// so few images need a larger z (about 7.3 for 9 images). The floor
+// so few images need a larger z (6.2 for 12 images, 7.6 for 9, 17 for 5). The floor
 // min_bias_px = 0.25 px keeps the sub-quarter-pixel deviations of a real
 // lens from any model family (and the sub-pixel biases of feature
 // detection) from counting, however many points there are. Where the data

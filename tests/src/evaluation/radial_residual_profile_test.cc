@@ -267,6 +267,10 @@ TEST(RadialResidualProfile, StudentThresholdMatchesTheNormalTail) {
   EXPECT_NEAR(StudentThresholdLikeNormal(5, 100000), 5.0, 1e-3);
   EXPECT_NEAR(StudentThresholdLikeNormal(1.959964, 10), 2.228139, 1e-4);
   EXPECT_GT(StudentThresholdLikeNormal(5, 11), 10);
+  // The default min_z = 4 for 12, 9 and 5 images (the README's figures).
+  EXPECT_NEAR(StudentThresholdLikeNormal(4, 11), 6.24, 0.01);
+  EXPECT_NEAR(StudentThresholdLikeNormal(4, 8), 7.60, 0.01);
+  EXPECT_NEAR(StudentThresholdLikeNormal(4, 4), 17.45, 0.01);
   EXPECT_TRUE(std::isinf(StudentThresholdLikeNormal(5, 0)));
 }
 
