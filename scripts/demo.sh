@@ -19,6 +19,9 @@
 #   DEMO_SCENE       room (default), courtyard, street
 #   DEMO_SEED        0 (default)
 #   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 20)
+#   DEMO_CAMERA_MODEL  --RigCalibrator.camera_model: auto (default, the
+#                    command's default), "true" (the rendered rig's true
+#                    models), or any value the option takes
 #   DEMO_SKIP_BUILD  1: use the built tree as it is
 #   RIG_CALIBRATOR_BUILD_DIR, COLMAP, MAP_*, RIG_*: see scripts/build.sh,
 #   scripts/build_map.sh and scripts/calibrate_rig.sh
@@ -33,6 +36,7 @@ scene="${DEMO_SCENE:-room}"
 seed="${DEMO_SEED:-0}"
 num_map_images="${DEMO_MAP_IMAGES:-60}"
 num_framesets="${DEMO_FRAMESETS:-20}"
+camera_model="${DEMO_CAMERA_MODEL:-auto}"
 # A folder this demo wrote before (it holds the marker file) is replaced; any
 # other non-empty folder is left alone.
 marker=".rig_calibrator_demo"
@@ -61,8 +65,9 @@ run_step "render ($preset, $scene)" "$colmap_extended" rig_calibrator render \
 
 truth="$dataset/ground_truth"
 map_params=$(awk '!/^#/ { print $4 }' "$truth/map_camera.txt")
-camera_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
-[[ -n "$map_params" && -n "$camera_models" ]] || die "incomplete ground truth in $truth"
+true_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
+[[ -n "$map_params" && -n "$true_models" ]] || die "incomplete ground truth in $truth"
+[[ "$camera_model" != true ]] || camera_model="$true_models"
 
 # Fewer features and a short matching window keep the demo fast: neighbours
 # in the rendered sequence share thousands of inlier matches.
@@ -70,10 +75,11 @@ run_step "map (colmap)" env MAP_MAX_FEATURES="${MAP_MAX_FEATURES:-2048}" \
   MAP_OVERLAP="${MAP_OVERLAP:-5}" bash "$repo/scripts/build_map.sh" \
   "$dataset/map_images" "$out/map" "$truth/map_image_positions.txt" "$map_params"
 
-# The camera model of every camera is the true one's (the lens type is known).
+# The camera models are chosen by the calibration (auto) unless
+# DEMO_CAMERA_MODEL says otherwise.
 run_step "calibration (colmap + rig_calibrator)" \
   bash "$repo/scripts/calibrate_rig.sh" "$out/map/database.db" "$out/map/sparse/0" \
-  "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_models"
+  "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_model"
 
 run_step "evaluation" "$colmap_extended" rig_calibrator evaluate \
   --reference_path "$truth/rig_config.json" \

@@ -30,7 +30,7 @@
 #   REAL_DATA_DIR     the shared data folder (default: ../shared/data beside
 #                     the repository)
 #   REAL_DATA_SPLITS  ring splits (default "mod:2:1 mod:2:0 mod:3:0 mod:3:1
-#                     mod:3:2 range:0:10 range:9:19"; see real_data_tools.py)
+#                     mod:3:2"; see real_data_tools.py)
 #   REAL_DATA_EUROC   1 (default): also the EuRoC pair (builds a COLMAP map,
 #                     a few minutes); 0: the ring only
 #   REAL_DATA_OPTIONS extra rig_calibrator options for the ring runs (default
@@ -44,7 +44,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 check_arguments 0 1 "$@"
 out="${1:-$repo/demo_output/real_data}"
 data="${REAL_DATA_DIR:-$(dirname "$repo")/shared/data}"
-splits="${REAL_DATA_SPLITS:-mod:2:1 mod:2:0 mod:3:0 mod:3:1 mod:3:2 range:0:10 range:9:19}"
+splits="${REAL_DATA_SPLITS:-mod:2:1 mod:2:0 mod:3:0 mod:3:1 mod:3:2}"
 with_euroc="${REAL_DATA_EUROC:-1}"
 read -r -a extra_options <<< "${REAL_DATA_OPTIONS:-}"
 marker=".real_data_check_output"

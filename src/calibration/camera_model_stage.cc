@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <iostream>
+#include <set>
+
+#include "src/calibration/pipeline_stages.h"
 
 namespace rig_calibrator {
 namespace {
@@ -195,6 +198,109 @@ void ChooseCameraModelsFromPoses(const PipelineOptions& options,
     }
     ReportModelChoice(options, dataset, static_cast<int>(c), choice, report);
   }
+}
+
+bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
+                                     const CalibrationMethod method,
+                                     const RigDataset& dataset,
+                                     RigCalibration* calibration,
+                                     PipelineReport* report) {
+  const FinalBundleAdjustmentOptions ba_options =
+      FinalBundleAdjustmentOptionsFor(options, method, dataset);
+  ModelChoiceAfterAdjustmentOptions choice_options =
+      options.model_choice_after_adjustment;
+  choice_options.loss_scale_px = ba_options.loss_scale_px;
+  choice_options.max_error_px = options.upgrade.max_error_px;
+  choice_options.validity = options.model_selection.validity;
+  bool changed = false;
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    if (!dataset.cameras[c].choose_model || !calibration->camera_calibrated[c] ||
+        !ba_options.refine_focal_length || !ba_options.refine_extra_params) {
+      continue;
+    }
+    choice_options.refine_principal_point =
+        ba_options.refine_principal_point &&
+        dataset.cameras[c].refinement.principal_point;
+    AdjustedCameraRows rows;
+    for (size_t i = 0; i < dataset.images.size(); ++i) {
+      const RigImage& image = dataset.images[i];
+      const ImageResult& result = calibration->images[i];
+      if (image.camera_index != static_cast<int>(c) || !result.used ||
+          !calibration->rig_from_world[image.frameset_index]) {
+        continue;
+      }
+      const Rigid3d& rig_from_world =
+          *calibration->rig_from_world[image.frameset_index];
+      for (size_t k = 0;
+           k < image.correspondences.size() && k < result.inlier_mask.size();
+           ++k) {
+        if (!result.inlier_mask[k]) continue;
+        const Correspondence& correspondence = image.correspondences[k];
+        const auto refined =
+            calibration->refined_points3D.find(correspondence.point3D_id);
+        const Eigen::Vector3d point_rig =
+            rig_from_world * (refined != calibration->refined_points3D.end()
+                                  ? refined->second
+                                  : correspondence.point3D);
+        rows.points2D.push_back(correspondence.point2D);
+        rows.points_rig.push_back(point_rig);
+        rows.framesets.push_back(image.frameset_index);
+      }
+    }
+    CameraModelReport& model_report =
+        CameraModelReportOf(dataset, static_cast<int>(c), report);
+    const std::string first_choice =
+        model_report.choice ? model_report.choice->chosen : "";
+    const bool first_uncertain =
+        model_report.choice && model_report.choice->uncertain;
+    const std::string current_model = calibration->cameras[c].ModelName();
+    colmap::Camera camera = calibration->cameras[c];
+    Rigid3d cam_from_rig = calibration->cam_from_rig[c];
+    ModelChoice choice;
+    if (!ChooseModelOnAdjustedRig(choice_options, rows, &camera, &cam_from_rig,
+                                  &choice)) {
+      // The upgrade's choice stands, and says why.
+      if (model_report.choice) {
+        model_report.choice->reason +=
+            "; not chosen again on the adjusted rig: " + choice.reason;
+      }
+      continue;
+    }
+    const int num_framesets = static_cast<int>(
+        std::set<int>(rows.framesets.begin(), rows.framesets.end()).size());
+    choice.reason += "; the first choice, at the camera upgrade, was " +
+                     (first_choice.empty() ? std::string("none")
+                                           : first_choice);
+    if (num_framesets < options.model_selection.min_num_framesets ||
+        first_uncertain) {
+      choice.uncertain = true;
+      choice.reason += ". The choice is not sure: " +
+                       std::to_string(num_framesets) +
+                       " framesets see this camera (held-out comparisons "
+                       "need at least " +
+                       std::to_string(options.model_selection.min_num_framesets) +
+                       "); give a model if you know the lens's";
+    }
+    // The same model: the adjustment's values stand (the fit held the rig
+    // and the points); another: the fit starts the adjustment's second run.
+    if (choice.chosen != current_model) {
+      calibration->cameras[c] = camera;
+      calibration->cam_from_rig[c] = cam_from_rig;
+      changed = true;
+    }
+    // The upgrade's warning, if any, is replaced by this choice's.
+    report->diagnostics.erase(
+        std::remove_if(report->diagnostics.begin(), report->diagnostics.end(),
+                       [&](const Diagnostic& diagnostic) {
+                         return diagnostic.code == "uncertain_model_choice" &&
+                                diagnostic.cameras ==
+                                    std::vector<int>{static_cast<int>(c)};
+                       }),
+        report->diagnostics.end());
+    model_report.choice.reset();
+    ReportModelChoice(options, dataset, static_cast<int>(c), choice, report);
+  }
+  return changed;
 }
 
 void CheckCameraModels(const PipelineOptions& options,

@@ -45,6 +45,21 @@ void ChooseCameraModelsFromPoses(const PipelineOptions& options,
                                  RigCalibration* calibration,
                                  PipelineReport* report);
 
+// The model choice on the adjusted rig (model_choice_after_adjustment.h)
+// for every calibrated camera whose model is "auto", after the final
+// adjustment: the choice and its table replace the upgrade's in the report
+// (its reason names the upgrade's choice). A camera whose chosen model
+// differs gets the candidate's fit (intrinsics and cam_from_rig); returns
+// true when some camera's model changed (the final adjustment is then run
+// again). The choice is marked uncertain (warning
+// "uncertain_model_choice") with fewer framesets than
+// ModelSelectionOptions::min_num_framesets, or when the upgrade's was.
+bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
+                                     CalibrationMethod method,
+                                     const RigDataset& dataset,
+                                     RigCalibration* calibration,
+                                     PipelineReport* report);
+
 // The validity of every calibrated camera's model, into
 // report->camera_models; an error diagnostic per invalid model (the camera
 // stays calibrated and is written: the command exits non-zero).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <random>
@@ -320,76 +321,22 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
   }
 
   std::vector<std::vector<double>> squared_errors(fits.size());
-  int best = -1;
   for (size_t m = 0; m < fits.size(); ++m) {
     if (!choice->candidates[m].valid) continue;
     squared_errors[m] =
         HeldOutSquaredErrors(options, upgrade_options, fits[m], points2D,
                              points_cam, groups, subset, evaluation_rows);
-    const double mse = Mean(squared_errors[m]);
-    choice->candidates[m].heldout_rms_px = std::sqrt(mse);
-    if (best < 0 || mse < Mean(squared_errors[best]))
-      best = static_cast<int>(m);
   }
-
-  // The one-standard-error rule over the paired differences to the best.
-  const double n = evaluation_rows.size();
-  int chosen = best;
-  std::vector<double> mean_difference(fits.size(), 0);
-  std::vector<double> standard_error(fits.size(), 0);
-  for (size_t m = 0; m < fits.size(); ++m) {
-    if (!choice->candidates[m].valid) continue;
-    double sum = 0, sum_squares = 0;
-    for (size_t e = 0; e < evaluation_rows.size(); ++e) {
-      const double d = squared_errors[m][e] - squared_errors[best][e];
-      sum += d;
-      sum_squares += d * d;
-    }
-    mean_difference[m] = sum / n;
-    const double variance =
-        n > 1 ? std::max(0.0, (sum_squares - sum * sum / n) / (n - 1)) : 0;
-    standard_error[m] = std::sqrt(variance / n);
-    const bool as_good =
-        mean_difference[m] <=
-        options.significance * standard_error[m] + kMinMseDifference;
-    ModelCandidate& candidate = choice->candidates[m];
-    if (static_cast<int>(m) != best) {
-      candidate.note = std::string(as_good ? "as good as" : "worse than") +
-                       " the best (mean squared error +" +
-                       Fixed(mean_difference[m], 5) + " px^2, standard error " +
-                       Fixed(standard_error[m], 5) + ")";
-    }
-    const ModelCandidate& current = choice->candidates[chosen];
-    if (as_good && (candidate.num_params < current.num_params ||
-                    (candidate.num_params == current.num_params &&
-                     candidate.heldout_rms_px < current.heldout_rms_px))) {
-      chosen = static_cast<int>(m);
-    }
-  }
-  if (chosen == best) {
-    choice->candidates[best].note = "lowest held-out error";
-  }
-  ModelCandidate& winner = choice->candidates[chosen];
-  winner.chosen = true;
-  choice->chosen = winner.model;
-  const ModelCandidate& best_candidate = choice->candidates[best];
-  const int num_folds = std::max(2, options.num_folds);
-  if (chosen == best) {
-    choice->reason = winner.model + " has the lowest held-out error (" +
-                     Fixed(winner.heldout_rms_px, 3) + " px over " +
-                     std::to_string(evaluation_rows.size()) +
-                     " correspondences, " + std::to_string(num_folds) +
-                     "-fold over framesets) and no model with fewer "
-                     "parameters is as good";
-  } else {
-    choice->reason =
-        winner.model + " (" + std::to_string(winner.num_params) +
-        " parameters, held-out " + Fixed(winner.heldout_rms_px, 3) +
-        " px) is within " + Fixed(options.significance, 1) +
-        " standard errors of the best, " + best_candidate.model + " (" +
-        std::to_string(best_candidate.num_params) + " parameters, " +
-        Fixed(best_candidate.heldout_rms_px, 3) + " px), with fewer parameters";
-  }
+  // Every row its own cluster: the upgrade's rows are compared as
+  // independent (its poses are the upgrade's, not yet adjusted).
+  std::vector<int> clusters(evaluation_rows.size());
+  std::iota(clusters.begin(), clusters.end(), 0);
+  const int chosen = ChooseByHeldOutError(
+      options.significance, squared_errors, clusters,
+      std::to_string(evaluation_rows.size()) + " correspondences, " +
+          std::to_string(std::max(2, options.num_folds)) +
+          "-fold over framesets",
+      choice);
   int num_invalid = 0;
   for (const ModelCandidate& candidate : choice->candidates) {
     if (candidate.fitted && !candidate.valid) ++num_invalid;
@@ -553,6 +500,101 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
                     "fitted to all of them)";
   *camera = chosen_camera;
   return true;
+}
+
+int ChooseByHeldOutError(double significance,
+                         const std::vector<std::vector<double>>& squared_errors,
+                         const std::vector<int>& clusters,
+                         const std::string& evaluation, ModelChoice* choice) {
+  const size_t num_candidates = choice->candidates.size();
+  int best = -1;
+  for (size_t m = 0; m < num_candidates; ++m) {
+    if (squared_errors[m].empty()) continue;
+    choice->candidates[m].heldout_rms_px = std::sqrt(Mean(squared_errors[m]));
+    if (best < 0 || Mean(squared_errors[m]) < Mean(squared_errors[best])) {
+      best = static_cast<int>(m);
+    }
+  }
+  if (best < 0) return -1;
+  // Cluster sums of the paired differences d_i = e_m,i^2 - e_best,i^2: the
+  // standard error of mean(d) is sqrt(G / (G - 1) sum_g (S_g - n_g mean)^2)
+  // / n over the G clusters (the sample standard deviation / sqrt(n) when
+  // every row is its own cluster).
+  std::vector<int> cluster_index(clusters.size());
+  std::map<int, int> index_of_cluster;
+  for (size_t e = 0; e < clusters.size(); ++e) {
+    cluster_index[e] =
+        index_of_cluster.emplace(clusters[e], index_of_cluster.size())
+            .first->second;
+  }
+  const double num_clusters = index_of_cluster.size();
+  const double n = clusters.size();
+  int chosen = best;
+  for (size_t m = 0; m < num_candidates; ++m) {
+    if (squared_errors[m].empty()) continue;
+    std::vector<double> cluster_sum(index_of_cluster.size(), 0);
+    std::vector<double> cluster_count(index_of_cluster.size(), 0);
+    double sum = 0;
+    for (size_t e = 0; e < clusters.size(); ++e) {
+      const double d = squared_errors[m][e] - squared_errors[best][e];
+      sum += d;
+      cluster_sum[cluster_index[e]] += d;
+      cluster_count[cluster_index[e]] += 1;
+    }
+    const double mean_difference = sum / n;
+    double spread = 0;
+    for (size_t g = 0; g < cluster_sum.size(); ++g) {
+      spread += std::pow(cluster_sum[g] - cluster_count[g] * mean_difference,
+                         2);
+    }
+    const double standard_error =
+        num_clusters > 1
+            ? std::sqrt(num_clusters / (num_clusters - 1) * spread) / n
+            : 0;
+    const bool as_good =
+        mean_difference <= significance * standard_error + kMinMseDifference;
+    ModelCandidate& candidate = choice->candidates[m];
+    if (static_cast<int>(m) != best) {
+      candidate.note = std::string(as_good ? "as good as" : "worse than") +
+                       " the best (mean squared error +" +
+                       Fixed(mean_difference, 5) + " px^2, standard error " +
+                       Fixed(standard_error, 5) + ")";
+    }
+    // Fewest parameters; on a tie the earlier candidate (candidates come
+    // pinhole-type first: a lens they fit as well needs no fisheye model).
+    if (as_good && (candidate.num_params < choice->candidates[chosen].num_params ||
+                    (candidate.num_params ==
+                         choice->candidates[chosen].num_params &&
+                     static_cast<int>(m) < chosen))) {
+      chosen = static_cast<int>(m);
+    }
+  }
+  if (chosen == best) {
+    choice->candidates[best].note = "lowest held-out error";
+  }
+  ModelCandidate& winner = choice->candidates[chosen];
+  winner.chosen = true;
+  choice->chosen = winner.model;
+  const ModelCandidate& best_candidate = choice->candidates[best];
+  if (chosen == best) {
+    choice->reason = winner.model + " has the lowest held-out error (" +
+                     Fixed(winner.heldout_rms_px, 3) + " px over " +
+                     evaluation + ") and no model with fewer parameters is "
+                     "as good";
+  } else {
+    choice->reason =
+        winner.model + " (" + std::to_string(winner.num_params) +
+        " parameters, held-out " + Fixed(winner.heldout_rms_px, 3) +
+        " px) is within " + Fixed(significance, 1) +
+        " standard errors of the best, " + best_candidate.model + " (" +
+        std::to_string(best_candidate.num_params) + " parameters, " +
+        Fixed(best_candidate.heldout_rms_px, 3) + " px over " + evaluation +
+        "), with " +
+        (winner.num_params < best_candidate.num_params
+             ? "fewer parameters"
+             : "as many parameters, earlier in the candidates' order");
+  }
+  return chosen;
 }
 
 std::string FormatModelChoice(const ModelChoice& choice,

@@ -19,8 +19,13 @@
 // candidate of least held-out error and, per row, d_i = e_m,i^2 - e_b,i^2,
 // a candidate m is as good as b when mean(d) <= z SE(d) + kMinMseDifference
 // (SE = standard deviation / sqrt(n), z = `significance`); of those, the one
-// with the fewest parameters wins (ties: the lower held-out error). More
-// parameters must earn their place by predicting unseen framesets better.
+// with the fewest parameters wins (ties: the earlier in the candidates'
+// order, pinhole-type before fisheye). More parameters must earn their place
+// by predicting unseen framesets better.
+//
+// This first choice is made at the camera upgrade, on the upgrade's poses,
+// so that the final adjustment has a model to start from; the final choice
+// is made again on the adjusted rig (model_choice_after_adjustment.h).
 //
 // Candidates (ModelSelectionOptions::candidate_models), why these:
 // SIMPLE_RADIAL, RADIAL, OPENCV cover pinhole-type lenses with no, radial
@@ -112,6 +117,20 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
                        const std::vector<Eigen::Vector3d>& points_cam,
                        const std::vector<int>& groups, colmap::Camera* camera,
                        CameraUpgradeResult* result, ModelChoice* choice);
+
+// The choice rule above over the candidates of `choice` whose
+// squared_errors (per evaluation row, the held-out squared error) are not
+// empty; clusters: per evaluation row the group whose rows are not
+// independent (the standard error of mean(d) is clustered by it:
+// sqrt(G / (G - 1) sum_g (S_g - n_g mean(d))^2) / n, S_g the sum of d over
+// group g). Sets the candidates' heldout_rms_px, notes and chosen flag,
+// choice->chosen and choice->reason (`evaluation` says over what the
+// held-out errors were taken). Returns the chosen candidate's index, -1
+// when no candidate was compared.
+int ChooseByHeldOutError(double significance,
+                         const std::vector<std::vector<double>>& squared_errors,
+                         const std::vector<int>& clusters,
+                         const std::string& evaluation, ModelChoice* choice);
 
 // The candidates' table (one line each) and the reason, for the terminal.
 std::string FormatModelChoice(const ModelChoice& choice,

@@ -104,6 +104,12 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
                                 report)) {
     return false;
   }
+  if (ChooseCameraModelsOnAdjustedRig(options, method, dataset, calibration,
+                                      report) &&
+      !RunFinalBundleAdjustment(options, method, dataset, calibration, report,
+                                "Final bundle adjustment, models changed")) {
+    return false;
+  }
   CheckCameraModels(options, dataset, *calibration, report);
   RunUncertaintyEstimation(options, method, dataset, *calibration, report);
   SummarizeCalibration(dataset, *calibration, report);

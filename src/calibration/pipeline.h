@@ -4,7 +4,10 @@
 // (initial_pose_estimation.h), rig initialization (rig_initializer.h or
 // complete_frameset_initialization.h), for 1dr the radial bundle adjustment
 // and the camera upgrade (radial_bundle_adjuster.h, camera_upgrader.h), and
-// the final bundle adjustment (final_bundle_adjuster.h).
+// the final bundle adjustment (final_bundle_adjuster.h), the model choice
+// on the adjusted rig for cameras whose model is "auto"
+// (model_choice_after_adjustment.h; the final adjustment runs again when a
+// model changed), the model checks and the uncertainty.
 //
 // Problems the pipeline can work around are reported as diagnostics instead
 // of failures (pipeline_report.h): e.g. a rig whose cameras all have parallel
@@ -19,6 +22,7 @@
 #include "src/calibration/camera_upgrader.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
+#include "src/calibration/model_choice_after_adjustment.h"
 #include "src/calibration/model_selection.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/calibration/principal_axes.h"
@@ -42,6 +46,10 @@ struct PipelineOptions {
   RadialBundleAdjustmentOptions radial_bundle_adjustment;
   CameraUpgradeOptions upgrade;
   ModelSelectionOptions model_selection;  // cameras with choose_model
+  // The choice made again after the final adjustment (its loss scale,
+  // inlier threshold, principal point switch and validity options are the
+  // pipeline's: set when it runs).
+  ModelChoiceAfterAdjustmentOptions model_choice_after_adjustment;
   FinalBundleAdjustmentOptions final_bundle_adjustment;
 
   // Correspondences within this radial error of the refined radial rig are

@@ -301,8 +301,9 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               CalibrationMethod method,
                               const RigDataset& dataset,
                               RigCalibration* calibration,
-                              PipelineReport* report) {
-  StageTimer stage("Final bundle adjustment", options.print_progress, report);
+                              PipelineReport* report,
+                              const std::string& stage_name) {
+  StageTimer stage(stage_name, options.print_progress, report);
   SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
   const FinalBundleAdjustmentOptions ba_options =
       FinalBundleAdjustmentOptionsFor(options, method, dataset);

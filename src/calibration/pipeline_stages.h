@@ -37,11 +37,15 @@ FinalBundleAdjustmentOptions FinalBundleAdjustmentOptionsFor(
 
 // The final bundle adjustment over the full inliers of the current rig;
 // the intrinsics are held for known and known_ra.
+// `stage_name` names it in the report (it runs twice when the model choice
+// on the adjusted rig changed a model).
 bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               CalibrationMethod method,
                               const RigDataset& dataset,
                               RigCalibration* calibration,
-                              PipelineReport* report);
+                              PipelineReport* report,
+                              const std::string& stage_name =
+                                  "Final bundle adjustment");
 
 // The uncertainty of the final bundle adjustment's result
 // (src/evaluation/calibration_uncertainty.h) into report->uncertainty, and

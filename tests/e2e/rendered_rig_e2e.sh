@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end test on rendered images (ctest: rendered_rig_e2e, label e2e):
 #   1. renders a small ring5 dataset in the room, builds a metric map and
-#      calibrates the rig against it (scripts/demo.sh: build_map.sh, then
+#      calibrates the rig against it with the default options, camera
+#      models chosen by auto (scripts/demo.sh: build_map.sh, then
 #      calibrate_rig.sh with the database), every step through the build's
 #      extended colmap: `colmap feature_extractor`, `colmap mapper`, ...,
 #      `colmap rig_calibrator` (checked in the scripts' logs);
@@ -100,18 +101,18 @@ fi
 echo "[e2e] check_calibration_outputs rejects the true rig's rig_config.json in place of the calibration's"
 
 # 4. A re-run from the correspondence file the run wrote, with the same map
-# and camera models, reproduces the run without the database.
-camera_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
+# and options (the demo's default, camera_model auto), reproduces the run
+# without the database.
 rerun="$work/rerun"
 start=$SECONDS
 "$colmap" rig_calibrator --correspondences_path "$calibration/correspondences.txt" \
   --input_path "$work/demo/map/sparse/0" --output_path "$rerun" \
-  --RigCalibrator.camera_model "$camera_models" > "$work/rerun.log" 2>&1 ||
+  > "$work/rerun.log" 2>&1 ||
   fail "the re-run from $calibration/correspondences.txt (log: $work/rerun.log)"
 echo "[e2e] re-run from correspondences.txt: $((SECONDS - start)) s"
 "$checker" "$rerun" "$calibration" ||
   fail "the re-run from correspondences.txt does not reproduce the run"
 
-bash "$repo/tests/e2e/determinism_e2e.sh" "$build" "$work/demo/rig/database.db" "$work/demo/dataset/rig_images" "$work/demo/map/sparse/0" "$truth" "$work/determinism" --RigCalibrator.camera_model "$camera_models" || fail "determinism (tests/e2e/determinism_e2e.sh)"
+bash "$repo/tests/e2e/determinism_e2e.sh" "$build" "$work/demo/rig/database.db" "$work/demo/dataset/rig_images" "$work/demo/map/sparse/0" "$truth" "$work/determinism" || fail "determinism (tests/e2e/determinism_e2e.sh)"
 [[ $# -ge 2 ]] || rm -rf "$work"
 echo "[e2e] passed (demo pipeline $demo_seconds s)"
