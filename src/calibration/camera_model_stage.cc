@@ -1,5 +1,7 @@
 #include "src/calibration/camera_model_stage.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <iostream>
 #include <set>
@@ -200,6 +202,42 @@ void ChooseCameraModelsFromPoses(const PipelineOptions& options,
   }
 }
 
+namespace {
+
+// One camera's final inliers for the model choice on the adjusted rig.
+AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
+                                  const RigCalibration& calibration,
+                                  const int camera_index) {
+  AdjustedCameraRows rows;
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const RigImage& image = dataset.images[i];
+    const ImageResult& result = calibration.images[i];
+    if (image.camera_index != camera_index || !result.used ||
+        !calibration.rig_from_world[image.frameset_index]) {
+      continue;
+    }
+    const Rigid3d& rig_from_world =
+        *calibration.rig_from_world[image.frameset_index];
+    for (size_t k = 0;
+         k < image.correspondences.size() && k < result.inlier_mask.size();
+         ++k) {
+      if (!result.inlier_mask[k]) continue;
+      const Correspondence& correspondence = image.correspondences[k];
+      const auto refined =
+          calibration.refined_points3D.find(correspondence.point3D_id);
+      rows.points2D.push_back(correspondence.point2D);
+      rows.points_rig.push_back(
+          rig_from_world * (refined != calibration.refined_points3D.end()
+                                ? refined->second
+                                : correspondence.point3D));
+      rows.framesets.push_back(image.frameset_index);
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
 bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
                                      const CalibrationMethod method,
                                      const RigDataset& dataset,
@@ -207,58 +245,51 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
                                      PipelineReport* report) {
   const FinalBundleAdjustmentOptions ba_options =
       FinalBundleAdjustmentOptionsFor(options, method, dataset);
+  std::vector<int> cameras;
+  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+    if (dataset.cameras[c].choose_model && calibration->camera_calibrated[c] &&
+        ba_options.refine_focal_length && ba_options.refine_extra_params) {
+      cameras.push_back(static_cast<int>(c));
+    }
+  }
+  if (cameras.empty()) return false;
+  StageTimer stage("Model choice on the adjusted rig", options.print_progress,
+                   report);
   ModelChoiceAfterAdjustmentOptions choice_options =
       options.model_choice_after_adjustment;
   choice_options.loss_scale_px = ba_options.loss_scale_px;
   choice_options.max_error_px = options.upgrade.max_error_px;
   choice_options.validity = options.model_selection.validity;
-  bool changed = false;
-  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
-    if (!dataset.cameras[c].choose_model || !calibration->camera_calibrated[c] ||
-        !ba_options.refine_focal_length || !ba_options.refine_extra_params) {
-      continue;
-    }
-    choice_options.refine_principal_point =
+
+  // The cameras' choices are independent: one thread each, the results
+  // applied in camera order below (the same whatever the thread count).
+  const int num_cameras = static_cast<int>(cameras.size());
+  std::vector<AdjustedCameraRows> rows(num_cameras);
+  std::vector<colmap::Camera> fitted(num_cameras);
+  std::vector<Rigid3d> fitted_cam_from_rig(num_cameras);
+  std::vector<ModelChoice> choices(num_cameras);
+  std::vector<char> chosen(num_cameras, 0);
+#pragma omp parallel for schedule(dynamic) \
+    num_threads(options.num_threads > 0 ? options.num_threads : omp_get_max_threads())
+  for (int j = 0; j < num_cameras; ++j) {
+    const int c = cameras[j];
+    ModelChoiceAfterAdjustmentOptions camera_options = choice_options;
+    camera_options.refine_principal_point =
         ba_options.refine_principal_point &&
         dataset.cameras[c].refinement.principal_point;
-    AdjustedCameraRows rows;
-    for (size_t i = 0; i < dataset.images.size(); ++i) {
-      const RigImage& image = dataset.images[i];
-      const ImageResult& result = calibration->images[i];
-      if (image.camera_index != static_cast<int>(c) || !result.used ||
-          !calibration->rig_from_world[image.frameset_index]) {
-        continue;
-      }
-      const Rigid3d& rig_from_world =
-          *calibration->rig_from_world[image.frameset_index];
-      for (size_t k = 0;
-           k < image.correspondences.size() && k < result.inlier_mask.size();
-           ++k) {
-        if (!result.inlier_mask[k]) continue;
-        const Correspondence& correspondence = image.correspondences[k];
-        const auto refined =
-            calibration->refined_points3D.find(correspondence.point3D_id);
-        const Eigen::Vector3d point_rig =
-            rig_from_world * (refined != calibration->refined_points3D.end()
-                                  ? refined->second
-                                  : correspondence.point3D);
-        rows.points2D.push_back(correspondence.point2D);
-        rows.points_rig.push_back(point_rig);
-        rows.framesets.push_back(image.frameset_index);
-      }
-    }
-    CameraModelReport& model_report =
-        CameraModelReportOf(dataset, static_cast<int>(c), report);
-    const std::string first_choice =
-        model_report.choice ? model_report.choice->chosen : "";
-    const bool first_uncertain =
-        model_report.choice && model_report.choice->uncertain;
-    const std::string current_model = calibration->cameras[c].ModelName();
-    colmap::Camera camera = calibration->cameras[c];
-    Rigid3d cam_from_rig = calibration->cam_from_rig[c];
-    ModelChoice choice;
-    if (!ChooseModelOnAdjustedRig(choice_options, rows, &camera, &cam_from_rig,
-                                  &choice)) {
+    rows[j] = AdjustedRowsOf(dataset, *calibration, c);
+    fitted[j] = calibration->cameras[c];
+    fitted_cam_from_rig[j] = calibration->cam_from_rig[c];
+    chosen[j] = ChooseModelOnAdjustedRig(camera_options, rows[j], &fitted[j],
+                                         &fitted_cam_from_rig[j], &choices[j]);
+  }
+
+  bool changed = false;
+  for (int j = 0; j < num_cameras; ++j) {
+    const int c = cameras[j];
+    ModelChoice& choice = choices[j];
+    CameraModelReport& model_report = CameraModelReportOf(dataset, c, report);
+    if (!chosen[j]) {
       // The upgrade's choice stands, and says why.
       if (model_report.choice) {
         model_report.choice->reason +=
@@ -266,8 +297,13 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
       }
       continue;
     }
+    const std::string first_choice =
+        model_report.choice ? model_report.choice->chosen : "";
+    const bool first_uncertain =
+        model_report.choice && model_report.choice->uncertain;
     const int num_framesets = static_cast<int>(
-        std::set<int>(rows.framesets.begin(), rows.framesets.end()).size());
+        std::set<int>(rows[j].framesets.begin(), rows[j].framesets.end())
+            .size());
     choice.reason += "; the first choice, at the camera upgrade, was " +
                      (first_choice.empty() ? std::string("none")
                                            : first_choice);
@@ -283,9 +319,9 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
     }
     // The same model: the adjustment's values stand (the fit held the rig
     // and the points); another: the fit starts the adjustment's second run.
-    if (choice.chosen != current_model) {
-      calibration->cameras[c] = camera;
-      calibration->cam_from_rig[c] = cam_from_rig;
+    if (choice.chosen != calibration->cameras[c].ModelName()) {
+      calibration->cameras[c] = fitted[j];
+      calibration->cam_from_rig[c] = fitted_cam_from_rig[j];
       changed = true;
     }
     // The upgrade's warning, if any, is replaced by this choice's.
@@ -293,12 +329,11 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
         std::remove_if(report->diagnostics.begin(), report->diagnostics.end(),
                        [&](const Diagnostic& diagnostic) {
                          return diagnostic.code == "uncertain_model_choice" &&
-                                diagnostic.cameras ==
-                                    std::vector<int>{static_cast<int>(c)};
+                                diagnostic.cameras == std::vector<int>{c};
                        }),
         report->diagnostics.end());
     model_report.choice.reset();
-    ReportModelChoice(options, dataset, static_cast<int>(c), choice, report);
+    ReportModelChoice(options, dataset, c, choice, report);
   }
   return changed;
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -209,6 +210,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
 
   std::vector<Fit> fits(options.candidate_models.size());
   std::vector<std::vector<double>> squared_errors(fits.size());
+  std::vector<double> training_mse(fits.size(), 0);
   std::vector<int> clusters;
   for (const int row : subset) clusters.push_back(rows.framesets[row]);
   if (subset.empty()) {
@@ -243,11 +245,12 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
         CheckModelValidity(fit.camera, options.validity);
     candidate.valid = validity.valid;
     // The table's inliers and training RMS: the rows the fit leaves within
-    // max_error_px.
+    // max_error_px; training_mse: the truncated mean squared error.
     double sum_squares = 0;
     for (const int row : subset) {
       const double squared_error = TruncatedSquaredError(
           fit, rows.points2D[row], rows.points_rig[row], options.max_error_px);
+      training_mse[m] += squared_error / subset.size();
       if (squared_error < options.max_error_px * options.max_error_px) {
         sum_squares += squared_error;
         ++candidate.num_inliers;
@@ -255,12 +258,29 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
     }
     candidate.train_rms_px =
         std::sqrt(sum_squares / std::max(1, candidate.num_inliers));
-    if (!candidate.valid) {
-      candidate.note = "invalid: " + validity.message;
-      choice->candidates.push_back(candidate);
+    if (!candidate.valid) candidate.note = "invalid: " + validity.message;
+    choice->candidates.push_back(candidate);
+  }
+
+  // Held out, fold k predicted by the full fit refitted without it, for the
+  // valid candidates whose training error is at most twice the least: a
+  // held-out error is no smaller than the training error, so the others
+  // cannot be as good as the best (and their folds are most of the cost).
+  double least_training_mse = std::numeric_limits<double>::infinity();
+  for (size_t m = 0; m < fits.size(); ++m) {
+    if (choice->candidates[m].valid) {
+      least_training_mse = std::min(least_training_mse, training_mse[m]);
+    }
+  }
+  for (size_t m = 0; m < fits.size(); ++m) {
+    ModelCandidate& candidate = choice->candidates[m];
+    if (!candidate.valid) continue;
+    if (training_mse[m] > 2 * least_training_mse + kMinMseDifference) {
+      candidate.note = "worse than the best: its training error alone is "
+                       "more than twice the least";
+      candidate.heldout_rms_px = std::numeric_limits<double>::quiet_NaN();
       continue;
     }
-    // Held out: fold k predicted by the full fit refitted without it.
     squared_errors[m].assign(subset.size(), 0);
     for (int fold = 0; fold < num_folds; ++fold) {
       std::vector<int> training;
@@ -269,7 +289,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
           training.push_back(row);
         }
       }
-      Fit fold_fit = fit;
+      Fit fold_fit = fits[m];
       FitRowsForModel(options, rows.points2D, rows.points_rig, training,
                       /*converting=*/false, options.max_num_fold_iterations,
                       &fold_fit);
@@ -281,7 +301,6 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
                                   rows.points_rig[row], options.max_error_px);
       }
     }
-    choice->candidates.push_back(candidate);
   }
   const int chosen = ChooseByHeldOutError(
       options.significance, squared_errors, clusters,

@@ -611,7 +611,10 @@ std::string FormatModelChoice(const ModelChoice& choice,
         << std::setw(11)
         << (candidate.fitted ? Fixed(candidate.train_rms_px, 3) : "-")
         << std::setw(13)
-        << (candidate.valid ? Fixed(candidate.heldout_rms_px, 3) : "-") << "  "
+        << (candidate.valid && std::isfinite(candidate.heldout_rms_px)
+                ? Fixed(candidate.heldout_rms_px, 3)
+                : "-")
+        << "  "
         << candidate.note << "\n";
   }
   out << indent

@@ -92,7 +92,8 @@ struct ModelCandidate {
   bool valid = false;   // fitted and valid over the whole image
   int num_inliers = 0;
   double train_rms_px = 0;    // over its inliers, the full fit
-  double heldout_rms_px = 0;  // 0 unless valid
+  // 0 unless valid; NaN when valid but not compared held out.
+  double heldout_rms_px = 0;
   bool chosen = false;
   std::string note;  // why dropped, or how it compares with the best
 };

@@ -36,6 +36,10 @@ constexpr int kMinNumClusters = 3;
 // beyond any determined calibration (sigma ratio 1e5) and far above the
 // rounding of a sum of a million products (1e-16 * 1e6).
 constexpr double kMinScaledEigenvalue = 1e-10;
+// At most this many map images whose poses the data do not determine are
+// left out before the uncertainty is given up
+// (EstimateCalibrationUncertainty).
+constexpr int kMaxHeldMapImages = 20;
 // A pixel whose unprojection does not project back within this distance is
 // where the estimated model is not invertible: no projection uncertainty.
 constexpr double kMaxRoundTripErrorPx = 0.01;
@@ -268,12 +272,21 @@ double Median(std::vector<double> values) {
 // The reduced problem of one calibration and its solution.
 class UncertaintyProblem {
  public:
+  // held_map_images: per map image, left out (see
+  // EstimateCalibrationUncertainty); empty: none.
   UncertaintyProblem(const FinalBundleAdjustmentOptions& ba_options,
                      const RigDataset& dataset,
-                     const RigCalibration& calibration)
-      : options_(ba_options), dataset_(dataset), calibration_(calibration) {}
+                     const RigCalibration& calibration,
+                     const std::vector<char>& held_map_images)
+      : options_(ba_options),
+        dataset_(dataset),
+        calibration_(calibration),
+        held_map_images_(held_map_images) {}
 
   bool Run(const UncertaintyOptions& options, CalibrationUncertainty* result);
+  // After a Run that failed on a singular reduced system: the map image
+  // whose pose held the smallest pivot, -1 when it was not a map pose.
+  int undetermined_map_image() const { return undetermined_map_image_; }
 
  private:
   void CollectObservations();
@@ -289,6 +302,7 @@ class UncertaintyProblem {
   int NumThreads() const;
   void AddGaugePriors();
   bool Marginalize(CalibrationUncertainty* result);
+  std::string DescribeNuisanceParameter(int index) const;
   void AnchorScale();
   void BetweenFramesetsCovariance(const Eigen::MatrixXd& unanchored);
   void FillCameras(const UncertaintyOptions& options,
@@ -303,6 +317,8 @@ class UncertaintyProblem {
   const RigCalibration& calibration_;
 
   std::vector<PoseArray> rig_from_world_, cam_from_rig_, map_cam_from_world_;
+  std::vector<char> held_map_images_;
+  int undetermined_map_image_ = -1;
   PoseArray identity_ = {1, 0, 0, 0, 0, 0, 0};
   std::vector<std::vector<int>> free_intrinsics_;  // per rig camera
   std::vector<int> all_map_intrinsics_;            // 0..n-1 of a map camera
@@ -441,6 +457,7 @@ void UncertaintyProblem::CollectObservations() {
       map_free_intrinsics_.push_back(all);
     }
     for (size_t m = 0; m < dataset_.map_images.size(); ++m) {
+      if (m < held_map_images_.size() && held_map_images_[m]) continue;
       const MapImage& image = dataset_.map_images[m];
       for (size_t k = 0; k < image.observations.size(); ++k) {
         const MapObservation& map_observation = image.observations[k];
@@ -869,6 +886,27 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
       result->message =
           "the rig and map poses are not all determined by the data (the "
           "reduced system is singular): the uncertainty is undetermined";
+      if (ldlt_o_.info() == Eigen::Success) {
+        // The factorization's smallest pivot, in the original order (P A
+        // P^T = L D L^T: original index i sits at P.indices()(i)).
+        Eigen::Index pivot = 0;
+        ldlt_o_.vectorD().minCoeff(&pivot);
+        const auto& indices = ldlt_o_.permutationP().indices();
+        for (Eigen::Index i = 0; i < indices.size(); ++i) {
+          if (indices(i) != pivot) continue;
+          result->message += " (first undetermined: " +
+                             DescribeNuisanceParameter(static_cast<int>(i)) +
+                             ")";
+          for (size_t m = 0; m < map_pose_block_.size(); ++m) {
+            const int block = map_pose_block_[m];
+            if (block >= 0 && i >= blocks_[block].offset &&
+                i < blocks_[block].offset + blocks_[block].dim) {
+              undetermined_map_image_ = static_cast<int>(m);
+            }
+          }
+          break;
+        }
+      }
       return false;
     }
     x_oc_ =
@@ -877,6 +915,34 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
   }
   covariance_c_ = ScaledPseudoInverse(schur, &undetermined_c_);
   return true;
+}
+
+// What the index-th nuisance (O) parameter belongs to, for messages.
+std::string UncertaintyProblem::DescribeNuisanceParameter(int index) const {
+  const auto owner_of = [&](const std::vector<int>& slot) {
+    for (size_t k = 0; k < slot.size(); ++k) {
+      if (slot[k] < 0) continue;
+      const Block& block = blocks_[slot[k]];
+      if (index >= block.offset && index < block.offset + block.dim) {
+        return static_cast<int>(k);
+      }
+    }
+    return -1;
+  };
+  int owner = owner_of(rig_pose_block_);
+  if (owner >= 0) {
+    return "the rig pose of frameset " +
+           (static_cast<size_t>(owner) < dataset_.frameset_names.size()
+                ? dataset_.frameset_names[owner]
+                : std::to_string(owner));
+  }
+  owner = owner_of(map_pose_block_);
+  if (owner >= 0) {
+    return "the pose of map image " + dataset_.map_images[owner].name;
+  }
+  owner = owner_of(map_intrinsics_block_);
+  if (owner >= 0) return "the intrinsics of map camera " + std::to_string(owner);
+  return "parameter " + std::to_string(index);
 }
 
 // Cov(d_C - n_C g) for the anchoring's scale g = a^T d (see the header):
@@ -1331,8 +1397,33 @@ CalibrationUncertainty EstimateCalibrationUncertainty(
   if (!ShapedLike(dataset, calibration)) {
     result.message = "the calibration does not match the dataset";
   } else {
-    UncertaintyProblem problem(ba_options, dataset, calibration);
-    result.computed = problem.Run(options, &result);
+    // A map image's pose that the data do not determine (it sees a few
+    // refined points, or points in a degenerate layout; the final
+    // adjustment's damping, not the data, held it) makes the whole reduced
+    // system singular: the image is left out and the uncertainty computed
+    // again. Left out, not held: a held pose with its observations would pin
+    // the free world (the map's gauge) to its few points. On the real EuRoC
+    // pair one such map image left the uncertainty uncomputed.
+    std::vector<char> held(dataset.map_images.size(), 0);
+    std::vector<std::string> held_names;
+    for (int attempt = 0; attempt <= kMaxHeldMapImages; ++attempt) {
+      result = CalibrationUncertainty();
+      UncertaintyProblem problem(ba_options, dataset, calibration, held);
+      result.computed = problem.Run(options, &result);
+      const int map_image = problem.undetermined_map_image();
+      if (result.computed || map_image < 0 || held[map_image]) break;
+      held[map_image] = 1;
+      held_names.push_back(dataset.map_images[map_image].name);
+    }
+    if (result.computed && !held_names.empty()) {
+      std::string names;
+      for (const std::string& name : held_names) {
+        names += (names.empty() ? "" : ", ") + name;
+      }
+      result.method += "; the poses of " + std::to_string(held_names.size()) +
+                       " map image(s) that the data do not determine left "
+                       "out (" + names + ")";
+    }
   }
   if (!result.computed) result.cameras.clear();
   result.seconds =
@@ -1353,6 +1444,14 @@ CalibrationUncertainty EstimateCalibrationUncertainty(
 //    on assuming the centre, while a principal point that wanders with the
 //    noise drags the camera's rotation (1 px ~ 1/f rad) and distortion with
 //    it. Holding it (refine_principal_point 0) then costs little.
+//  - kFramesetsDisagreeFactor = 3: on maps with independent errors, and on
+//    synthetic maps made like structure from motion (drift, noisy poses,
+//    points triangulated through them), the between-framesets sigma is
+//    within 1.5x of the noise sigma; on the real EuRoC pair it is 8-10x,
+//    and that camera's rotation was 0.7 deg from the pattern calibration,
+//    20 sigma of the noise covariance. Errors that every observation of a
+//    frameset or map image shares then dominate, and a sandwich over a
+//    few dozen clusters underestimates them.
 std::vector<Diagnostic> UncertaintyDiagnostics(
     const RigDataset& dataset, const RigCalibration& calibration,
     const CalibrationUncertainty& uncertainty) {
@@ -1446,6 +1545,23 @@ std::vector<Diagnostic> UncertaintyDiagnostics(
           format(kLargeProjectionStddevPx, 1) +
           " px): the data determine this camera's projection poorly there; "
           "add framesets whose features reach that part of the image";
+      diagnostic.cameras = {static_cast<int>(c)};
+      diagnostics.push_back(diagnostic);
+    }
+    if (camera.between_framesets_factor > kFramesetsDisagreeFactor) {
+      Diagnostic diagnostic;
+      diagnostic.level = Diagnostic::Level::kWarning;
+      diagnostic.code = "framesets_disagree";
+      diagnostic.message =
+          name + ": the framesets and map images disagree " +
+          format(camera.between_framesets_factor, 1) +
+          "x more than the pixel noise explains (above " +
+          format(kFramesetsDisagreeFactor, 1) +
+          "x): errors shared by the observations of one frameset or map "
+          "image (the map's own errors, cameras not triggered together, a "
+          "lens the model does not follow) dominate this camera's "
+          "calibration, and its sigma, taken from their spread, may still "
+          "be too small; compare with a calibration from other framesets";
       diagnostic.cameras = {static_cast<int>(c)};
       diagnostics.push_back(diagnostic);
     }

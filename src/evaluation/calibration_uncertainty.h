@@ -178,12 +178,15 @@ CalibrationUncertainty EstimateCalibrationUncertainty(
 // Thresholds of the diagnostics (why these values: calibration_uncertainty.cc).
 constexpr double kLargeProjectionStddevPx = 1.0;
 constexpr double kPoorPrincipalPointStddevPx = 1.0;
+constexpr double kFramesetsDisagreeFactor = 3.0;
 
 // The warnings "large_projection_uncertainty" (a camera's worst projection
 // standard deviation above kLargeProjectionStddevPx), "poorly_determined_
 // principal_point" (a principal point coordinate's standard deviation above
 // kPoorPrincipalPointStddevPx, or undetermined: suggests
-// --RigCalibrator.refine_principal_point 0) and "undetermined_parameters".
+// --RigCalibrator.refine_principal_point 0), "framesets_disagree" (a
+// camera's between_framesets_factor above kFramesetsDisagreeFactor) and
+// "undetermined_parameters".
 std::vector<Diagnostic> UncertaintyDiagnostics(
     const RigDataset& dataset, const RigCalibration& calibration,
     const CalibrationUncertainty& uncertainty);

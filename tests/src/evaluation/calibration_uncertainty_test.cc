@@ -218,6 +218,83 @@ TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
   }
 }
 
+// A map image that sees two refined points: the adjustment moves its pose
+// (held by its damping, not by the data) and the reduced system is
+// singular there, as on the real EuRoC pair. The image is left out, the
+// uncertainty computed and the image named, the rig's sigma as without it.
+TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
+  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 7);
+  options.num_map_images = 24;
+  options.outlier_ratio = 0;
+  SyntheticRig rig = GenerateSyntheticRig(options);
+  KeepCorrespondencesWithMapTracks(&rig);
+  const FinalBundleAdjustmentOptions ba = MapAdjustment();
+  RigCalibration calibration = StartAtTruth(rig);
+  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
+  const CalibrationUncertainty reference =
+      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
+  ASSERT_TRUE(reference.computed) << reference.message;
+
+  MapImage sparse = rig.dataset.map_images[0];
+  sparse.name = "sparse.png";
+  sparse.image_id = 999999;
+  sparse.observations.clear();
+  for (const MapObservation& observation :
+       rig.dataset.map_images[0].observations) {
+    if (calibration.refined_points3D.count(observation.point3D_id) &&
+        sparse.observations.size() < 2) {
+      sparse.observations.push_back(observation);
+    }
+  }
+  ASSERT_EQ(sparse.observations.size(), 2u);
+  rig.dataset.map_images.push_back(sparse);
+  calibration = StartAtTruth(rig);
+  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
+  const CalibrationUncertainty uncertainty =
+      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
+  ASSERT_TRUE(uncertainty.computed) << uncertainty.message;
+  EXPECT_NE(uncertainty.method.find("1 map image(s)"), std::string::npos)
+      << uncertainty.method;
+  EXPECT_NE(uncertainty.method.find("sparse.png"), std::string::npos);
+  for (size_t c = 0; c < uncertainty.cameras.size(); ++c) {
+    const CameraUncertainty& camera = uncertainty.cameras[c];
+    ASSERT_TRUE(camera.computed && camera.determined);
+    EXPECT_TRUE(AllFinite(camera));
+    EXPECT_NEAR(camera.rotation_stddev_deg,
+                reference.cameras[c].rotation_stddev_deg,
+                0.05 * reference.cameras[c].rotation_stddev_deg + 1e-9);
+  }
+}
+
+// "framesets_disagree" names the camera whose between-framesets sigma is
+// more than kFramesetsDisagreeFactor times its noise sigma, and only it.
+TEST(CalibrationUncertainty, FramesetsThatDisagreeAreDiagnosed) {
+  const SyntheticRig rig = GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 8));
+  const RigCalibration calibration = StartAtTruth(rig);
+  CalibrationUncertainty uncertainty;
+  uncertainty.computed = true;
+  uncertainty.num_clusters = 8;
+  for (size_t c = 0; c < rig.dataset.cameras.size(); ++c) {
+    CameraUncertainty camera;
+    camera.computed = true;
+    camera.determined = true;
+    camera.params_stddev.assign(calibration.cameras[c].NumParams(), 0.1);
+    camera.between_framesets_factor =
+        c == 2 ? kFramesetsDisagreeFactor * 1.1 : kFramesetsDisagreeFactor;
+    uncertainty.cameras.push_back(camera);
+  }
+  int num_disagree = 0;
+  for (const Diagnostic& diagnostic :
+       UncertaintyDiagnostics(rig.dataset, calibration, uncertainty)) {
+    if (diagnostic.code != "framesets_disagree") continue;
+    ++num_disagree;
+    EXPECT_EQ(diagnostic.cameras, std::vector<int>{2});
+    EXPECT_EQ(diagnostic.message.rfind(rig.dataset.cameras[2].name + ":", 0),
+              0u);
+  }
+  EXPECT_EQ(num_disagree, 1);
+}
+
 TEST(CalibrationUncertainty, ResultDoesNotDependOnThreadCount) {
   SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
   options.num_map_images = 24;
@@ -335,7 +412,7 @@ TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
     ASSERT_TRUE(uncertainty.computed) << uncertainty.message;
     const std::vector<Diagnostic> diagnostics =
         UncertaintyDiagnostics(rig.dataset, calibration, uncertainty);
-    bool principal_point = false, projection = false;
+    bool principal_point = false, projection = false, disagree = false;
     for (const Diagnostic& diagnostic : diagnostics) {
       if (diagnostic.code == "poorly_determined_principal_point") {
         principal_point = true;
@@ -344,11 +421,14 @@ TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
             std::string::npos);
       }
       projection |= diagnostic.code == "large_projection_uncertainty";
+      disagree |= diagnostic.code == "framesets_disagree";
       std::printf("%s data: %s %s\n", poor ? "poor" : "good",
                   diagnostic.code.c_str(), diagnostic.message.c_str());
     }
     EXPECT_EQ(principal_point, poor);
     EXPECT_EQ(projection, poor);
+    // Independent errors: the framesets agree with the pixel noise.
+    EXPECT_FALSE(disagree);
   }
 }
 
