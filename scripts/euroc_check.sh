@@ -24,7 +24,9 @@
 #   OUTPUT_DIR must not exist or be empty; EUROC_OVERWRITE=1 replaces an
 #   earlier output of this script (recognized by its marker file).
 # Environment:
-#   EUROC_DIR          the data (default /work/shared/data/euroc_v1_01_micro):
+#   EUROC_DIR          the data (default: ../shared/data/euroc_v1_01_micro
+#                      beside the repository, as REAL_DATA_DIR of
+#                      scripts/real_data_check.sh):
 #                      mav0/cam{0,1}/sensor.yaml, mav0/cam{0,1}/data/*.png
 #   EUROC_MAP_EVERY    map framesets: every N-th (default 8, i.e. 12 framesets)
 #   EUROC_MAP_MODEL    camera model of the map's self-calibration (default
@@ -42,7 +44,7 @@ log_tag=euroc
 # shellcheck source=common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 out="${1:-$repo/demo_output/euroc}"
-data="${EUROC_DIR:-/work/shared/data/euroc_v1_01_micro}"
+data="${EUROC_DIR:-$(dirname "$repo")/shared/data/euroc_v1_01_micro}"
 map_every="${EUROC_MAP_EVERY:-8}"
 map_model="${EUROC_MAP_MODEL:-RADIAL}"
 camera_model="${EUROC_CAMERA_MODEL:-auto}"
@@ -52,6 +54,8 @@ marker=".euroc_check_output"
 
 check_arguments 0 1 "$@"
 [[ "$map_every" =~ ^[1-9][0-9]*$ ]] || die "EUROC_MAP_EVERY must be a positive integer, got '$map_every'"
+[[ -d "$data" ]] ||
+  die "no EuRoC data at $data (the default is ../shared/data/euroc_v1_01_micro beside the repository): set EUROC_DIR to the folder holding mav0/"
 for camera in cam0 cam1; do
   [[ -f "$data/mav0/$camera/sensor.yaml" && -d "$data/mav0/$camera/data" ]] ||
     die "no $data/mav0/$camera/{sensor.yaml,data/}: set EUROC_DIR to the EuRoC folder"

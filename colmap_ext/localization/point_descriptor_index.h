@@ -2,8 +2,8 @@
 // point contributes a few descriptors of its track (the observations in the
 // map images); a FLANN kd-tree forest over all of them, built once per map,
 // answers one query per feature of an image to localize. This replaces
-// matching the image against each retrieved map image (DESIGN.md, "Where the
-// time goes").
+// matching the image against each retrieved map image, where most of the
+// localization's time went (retrieval mode still does that).
 //
 // Distances follow COLMAP's SIFT matcher (feature/sift.cc): SIFT descriptors
 // are stored as uint8 with L2 norm ~512, and the distance of two descriptors

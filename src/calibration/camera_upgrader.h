@@ -1,4 +1,4 @@
-// Camera upgrade (paper §3.5 "Camera Upgrading and Refinement", MATH.md §3):
+// Camera upgrade (paper §3.5 "Camera Upgrading and Refinement"):
 // from a camera's 1D radial pose (R, tx, ty known, tz unknown) and its 2D-3D
 // correspondences, estimate the forward translation tz and all intrinsics of
 // a COLMAP camera model.
@@ -63,7 +63,7 @@ struct CameraUpgradeResult {
   int num_inliers = 0;
   double rms_px = 0;  // full reprojection RMS over the inliers
 
-  // Conditioning of the tz/focal trade-off (MATH.md §3 pitfalls). With
+  // Conditioning of the tz/focal trade-off. With
   // C = (J^T J)^-1, J the (Cauchy-weighted) Jacobian of the final LM's
   // residuals in pixels over tz and every refined parameter, and f the mean
   // of the model's focal lengths:

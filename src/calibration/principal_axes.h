@@ -1,5 +1,5 @@
 // What the principal axes of a 1D radial rig determine (paper eq. 3 and
-// Limitations, MATH.md §4). A radial camera observes only the first two rows
+// Limitations). A radial camera observes only the first two rows
 // of its pose, so its position along its own principal axis z is unknown:
 //  - a rig pose's translation is determined by the radial rows of cameras
 //    with axes z_k only if N = sum_k (I - z_k z_k^T) is regular. For two

@@ -6,7 +6,7 @@
 // the distance of the observation from its predicted radial line, which
 // does not depend on focal length, distortion or tz. rho is a Cauchy loss.
 //
-// Gauge (MATH.md §4, rig_initializer.h): the reference camera's
+// Gauge (see "Gauge of radial rigs" in rig_initializer.h): the reference camera's
 // cam_from_rig stays the identity, every camera's tz stays 0, and the slide
 // of the rig origin along the reference camera's axis is fixed by
 // NormalizeRadialRigOrigin after the solve.

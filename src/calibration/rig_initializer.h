@@ -11,14 +11,14 @@
 //   min_{P_i, Q_j} sum_{(i,j)} rho(d(T_ij, P_i Q_j)),
 // with a Cauchy loss rho.
 //
-// Gauge of radial rigs (MATH.md §4). A radial camera's position along its own
+// Gauge of radial rigs. A radial camera's position along its own
 // principal axis is unobservable, and that includes the reference camera:
 // the rig origin can slide by d along the reference camera's axis, which
 // changes no radial projection but changes every other camera's (tx, ty) by
 // d (R_i e_z)_xy. The radial stages therefore store tz = 0 for every camera
 // and fix d with NormalizeRadialRigOrigin (principal_axes.h); the reference
 // camera's cam_from_rig is the identity in that sense (its tz is unknown). Once
-// the forward translations are estimated (upgrade, MATH.md §3), including the
+// the forward translations are estimated (camera_upgrader.h), including the
 // reference camera's, re-expressing everything in the reference camera's
 // frame (Q_j <- P_ref Q_j, P_i <- P_i P_ref^-1) makes the rig metric.
 #pragma once

@@ -1,6 +1,6 @@
 // Linear solver for tz, the focal length and a division ("undistortion")
 // model of radial distortion, given a camera's 1D radial pose (Kukelova et al.
-// ICCV'13, second step; radial_solvers.md §3.1). It brackets the search of
+// ICCV'13, second step; the model is stated below). It brackets the search of
 // the least-squares upgrade (radial_intrinsics_least_squares.h). Notation:
 // radial_intrinsics.h.
 #pragma once

@@ -1,5 +1,5 @@
 // Minimal solver for tz, the focal length and radial distortion of a camera
-// whose 1D radial pose (R, tx, ty) is known (paper §3.5, MATH.md §3; the
+// whose 1D radial pose (R, tx, ty) is known (paper §3.5; the
 // polynomial case is Larsson et al. ICCV'19's D(n, 0) with the pose known).
 // The minimal estimator of the upgrade's LO-RANSAC
 // (radial_intrinsics_estimator.h). Notation: radial_intrinsics.h.

@@ -1,4 +1,4 @@
-// The model the camera upgrade estimates (paper §3.5, MATH.md §3): the
+// The model the camera upgrade estimates (paper §3.5): the
 // forward translation tz, the focal length and the first radial distortion
 // terms of a camera whose 1D radial pose (R, tx, ty) is known.
 //

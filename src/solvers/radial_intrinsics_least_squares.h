@@ -1,6 +1,6 @@
 // Least-squares upgrade of a camera from many correspondences: tz, the focal
 // length and radial distortion given its 1D radial pose (paper §3.5,
-// radial_solvers.md §3.4). The local estimator of the upgrade's LO-RANSAC
+// the method is stated below). The local estimator of the upgrade's LO-RANSAC
 // (radial_intrinsics_estimator.h). Notation: radial_intrinsics.h.
 #pragma once
 

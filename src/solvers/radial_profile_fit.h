@@ -1,5 +1,5 @@
 // Linear fit of the focal length and radial distortion of a radial profile
-// for a fixed tz (paper §3.5, radial_solvers.md §3.3-3.4): the inner problem
+// for a fixed tz (paper §3.5; the formula is under Method below): the inner problem
 // of the least-squares upgrade (radial_intrinsics_least_squares.h). Notation:
 // radial_intrinsics.h.
 #pragma once
