@@ -25,7 +25,7 @@ shift || true
 [[ "$seconds" =~ ^[0-9]+$ && "$seconds" -gt 0 ]] ||
   die "SECONDS must be a positive integer, got '$seconds'"
 all_targets=(correspondence rig_config camchain rig_layout model rigs_frames
-  database_file database_blob)
+  database_file database_blob pipeline)
 targets=("$@")
 [[ ${#targets[@]} -gt 0 ]] || targets=("${all_targets[@]}")
 cache="${RIG_CALIBRATOR_CACHE:-$HOME/.cache/rig_calibrator}"
