@@ -75,6 +75,15 @@ bool CheckCamerasAndImages(const std::string& path, const std::string& suffix,
   return true;
 }
 
+// Whether `point2D` is a finite observation of point `point3D_id`.
+// HasPoint3D: a point read with the id -1 (kInvalidPoint3DId, a points2D's
+// "no point") is not confirmed by a points2D without a point.
+bool ConfirmsPoint(const colmap::Point2D& point2D,
+                   const colmap::point3D_t point3D_id) {
+  return point2D.HasPoint3D() && point2D.Point3DId() == point3D_id &&
+         point2D.XY().allFinite();
+}
+
 // Drops the track elements that their image does not confirm (and repeated
 // ones); returns the observations that the remaining tracks hold, each with
 // its point.
@@ -86,19 +95,16 @@ std::unordered_map<uint64_t, colmap::point3D_t> RepairTracks(
     std::vector<colmap::TrackElement> kept;
     kept.reserve(track.Length());
     for (const colmap::TrackElement& element : track.Elements()) {
-      const uint64_t key =
-          ObservationKey(element.image_id, element.point2D_idx);
       const bool confirmed =
           map->ExistsImage(element.image_id) &&
           element.point2D_idx < map->Image(element.image_id).NumPoints2D() &&
-          map->Image(element.image_id)
-                  .Point2D(element.point2D_idx)
-                  .Point3DId() == point3D_id &&
-          map->Image(element.image_id)
-              .Point2D(element.point2D_idx)
-              .XY()
-              .allFinite() &&
-          tracked.emplace(key, point3D_id).second;
+          ConfirmsPoint(
+              map->Image(element.image_id).Point2D(element.point2D_idx),
+              point3D_id) &&
+          tracked
+              .emplace(ObservationKey(element.image_id, element.point2D_idx),
+                       point3D_id)
+              .second;
       if (confirmed) {
         kept.push_back(element);
         continue;

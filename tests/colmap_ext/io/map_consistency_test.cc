@@ -5,8 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <limits>
 #include <string>
+
+#include "tests/testing.h"
 
 namespace rig_calibrator {
 namespace {
@@ -160,6 +163,26 @@ TEST(MapConsistency, TrackElementsThatNoImageConfirms) {
   EXPECT_FALSE(map.ExistsPoint3D(orphan_id));
   EXPECT_EQ(map.Point3D(1).Track().Length(), 3u);
   EXPECT_EQ(map.Point3D(2).Track().Length(), 3u);
+}
+
+// points3D.txt with a point of id -1, which COLMAP reads as
+// kInvalidPoint3DId, the id of "no point" of a points2D: the points2D it
+// lists have no point, so it is dropped.
+TEST(MapConsistency, PointWithTheInvalidIdIsDropped) {
+  colmap::Reconstruction map;
+  std::string error;
+  colmap::Reconstruction consistent = ConsistentMap();
+  testing::ScopedTempDir temp;
+  consistent.WriteText(temp.path());
+  std::ofstream(temp.path() + "/points3D.txt", std::ios::app)
+      << "-1 0 0 5 0 0 0 0.5 1 " << kNumPoints << " 2 " << kNumPoints
+      << "\n";
+  map.ReadText(temp.path());
+  ASSERT_TRUE(map.ExistsPoint3D(colmap::kInvalidPoint3DId));
+  const MapRepairs repairs = Repair(&map);
+  EXPECT_EQ(repairs.num_dropped_track_elements, 2);
+  EXPECT_EQ(repairs.num_dropped_points, 1);
+  EXPECT_FALSE(map.ExistsPoint3D(colmap::kInvalidPoint3DId));
 }
 
 TEST(MapConsistency, PointAtNoFinitePositionIsDroppedWithItsObservations) {
