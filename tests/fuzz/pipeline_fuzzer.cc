@@ -6,7 +6,9 @@
 // the file (the text or binary map's cameras, images or points3D, the
 // correspondence file, rig_config.json or camchain.yaml as known
 // intrinsics), the rest is its content. The command must end with exit code
-// 0 or 1 and, on 1, leave no output folder.
+// 0 or 1 and leave no partial output: no output folder, or a complete one (a
+// run whose cameras are flagged invalid writes its output and exits with 1),
+// and no temporary folder.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -64,7 +66,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const int exit_code =
       RunCalibrateWith(fuzz::PipelineArguments(folder, selected, output));
   if (exit_code != EXIT_SUCCESS && exit_code != EXIT_FAILURE) std::abort();
-  if (exit_code == EXIT_FAILURE && fs::exists(output)) std::abort();
+  if (exit_code == EXIT_SUCCESS && !fs::exists(output)) std::abort();
+  // report.html is written last into the temporary folder, before it is
+  // renamed into place (atomic_output.h).
+  if (fs::exists(output) && !fs::exists(output + "/report.html")) std::abort();
+  for (const auto& entry : fs::directory_iterator(fuzz::ScratchFolder())) {
+    if (entry.path().filename().string().rfind(".out.tmp", 0) == 0) {
+      std::abort();
+    }
+  }
   fs::remove_all(output);
   fs::copy_file(fuzz::ScratchFolder() + "/valid/" + selected,
                 folder + "/" + selected,
