@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of tests/fuzz (one per reader, with
-# AddressSanitizer and UndefinedBehaviorSanitizer; clang) into build-fuzz/
+# Builds the libFuzzer targets of tests/fuzz (one per reader and one of the
+# whole calibrate command, with AddressSanitizer and
+# UndefinedBehaviorSanitizer; clang) into build-fuzz/
 # (or $RIG_CALIBRATOR_FUZZ_BUILD_DIR) and runs each for SECONDS seconds,
 # starting from its seed corpus tests/fuzz/corpus/<target>/ and the inputs it
 # kept from earlier runs (build-fuzz/corpus/<target>/). Prints per target the
