@@ -19,6 +19,19 @@ uint64_t ObservationKey(const colmap::image_t image_id,
 
 std::string Id(const uint64_t id) { return std::to_string(id); }
 
+// The point ids in increasing order, so that the repairs' examples are the
+// same on every run and platform.
+std::vector<colmap::point3D_t> SortedPointIds(
+    const colmap::Reconstruction& map) {
+  std::vector<colmap::point3D_t> ids;
+  ids.reserve(map.NumPoints3D());
+  for (const auto& [point3D_id, point3D] : map.Points3D()) {
+    ids.push_back(point3D_id);
+  }
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
 // Why `camera` cannot be projected with, or empty.
 std::string CameraProblem(const colmap::Camera& camera) {
   if (camera.Width() == 0 || camera.Height() == 0) {
@@ -90,7 +103,7 @@ bool ConfirmsPoint(const colmap::Point2D& point2D,
 std::unordered_map<uint64_t, colmap::point3D_t> RepairTracks(
     colmap::Reconstruction* map, MapRepairs* repairs) {
   std::unordered_map<uint64_t, colmap::point3D_t> tracked;
-  for (const colmap::point3D_t point3D_id : map->Point3DIds()) {
+  for (const colmap::point3D_t point3D_id : SortedPointIds(*map)) {
     colmap::Track& track = map->Point3D(point3D_id).Track();
     std::vector<colmap::TrackElement> kept;
     kept.reserve(track.Length());
@@ -128,6 +141,7 @@ void RepairObservations(
   for (const auto& [image_id, image] : map->Images()) {
     image_ids.push_back(image_id);
   }
+  std::sort(image_ids.begin(), image_ids.end());
   for (const colmap::image_t image_id : image_ids) {
     colmap::Image& image = map->Image(image_id);
     for (colmap::point2D_t idx = 0; idx < image.NumPoints2D(); ++idx) {
@@ -151,7 +165,7 @@ void RepairObservations(
 // Drops the points without a track or at no finite position (the tracks
 // are consistent by now, so COLMAP's DeletePoint3D finds every image).
 void RepairPoints(colmap::Reconstruction* map, MapRepairs* repairs) {
-  for (const colmap::point3D_t point3D_id : map->Point3DIds()) {
+  for (const colmap::point3D_t point3D_id : SortedPointIds(*map)) {
     const colmap::Point3D& point3D = map->Point3D(point3D_id);
     const bool has_track = point3D.Track().Length() > 0;
     if (has_track && point3D.XYZ().allFinite()) continue;
