@@ -32,7 +32,7 @@ const std::string& CaseFolder() {
     const std::string valid = fuzz::ScratchFolder() + "/valid";
     const std::string run = fuzz::ScratchFolder() + "/case";
     fuzz::WritePipelineCase(valid);
-    fs::copy(valid, run, fs::copy_options::recursive);
+    fuzz::WritePipelineCase(run);
     return run;
   }();
   return folder;
@@ -76,8 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   fs::remove_all(output);
-  fs::copy_file(fuzz::ScratchFolder() + "/valid/" + selected,
-                folder + "/" + selected,
-                fs::copy_options::overwrite_existing);
+  fuzz::CopyFile(fuzz::ScratchFolder() + "/valid/" + selected,
+                 folder + "/" + selected);
   return 0;
 }
