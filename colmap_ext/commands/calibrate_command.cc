@@ -30,6 +30,9 @@ bool ReadInputMap(const CalibrateOptions& options, colmap::Reconstruction* map,
   for (const std::string& note : info->notes) {
     std::cout << "  " << note << std::endl;
   }
+  for (const std::string& warning : info->warnings) {
+    std::cerr << "warning: " << warning << std::endl;
+  }
   return true;
 }
 

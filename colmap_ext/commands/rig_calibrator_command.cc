@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/commands/guarded_run.h"
 #include "colmap_ext/commands/render_command.h"
 
 namespace rig_calibrator {
@@ -68,10 +69,8 @@ int ShowHelp(const std::string& program) {
   return EXIT_SUCCESS;
 }
 
-}  // namespace
-
-int RunRigCalibrator(const std::string& program, int argc, char** argv) {
-  InitializeLogging(argv);
+// Dispatches to the sub-command (see RunRigCalibrator).
+int DispatchCommand(const std::string& program, int argc, char** argv) {
   if (argc == 1) return ShowHelp(program);
   const std::string first = argv[1];
   if (first == "help" || first == "commands") return ShowHelp(program);
@@ -87,6 +86,13 @@ int RunRigCalibrator(const std::string& program, int argc, char** argv) {
   std::cerr << "ERROR: unknown command `" << first << "`; run `" << program
             << " help` for the list." << std::endl;
   return EXIT_FAILURE;
+}
+
+}  // namespace
+
+int RunRigCalibrator(const std::string& program, int argc, char** argv) {
+  InitializeLogging(argv);
+  return RunGuarded([&] { return DispatchCommand(program, argc, argv); });
 }
 
 }  // namespace rig_calibrator

@@ -13,7 +13,8 @@ namespace rig_calibrator {
 // `calibrate` (so `PROGRAM -h` shows the calibration options). `program` is
 // how the user invoked the command ("rig_calibrator" or "colmap
 // rig_calibrator"), used in the usage and error messages. Returns the exit
-// code.
+// code; an exception that escapes a sub-command ends it with a one-line
+// error and EXIT_FAILURE (RunGuarded).
 int RunRigCalibrator(const std::string& program, int argc, char** argv);
 
 }  // namespace rig_calibrator

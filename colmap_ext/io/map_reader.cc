@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "colmap_ext/io/colmap_camera_models.h"
+#include "colmap_ext/io/map_consistency.h"
 #include "colmap_ext/io/model_unique_ids.h"
 #include "colmap_ext/io/rigs_frames_io.h"
 
@@ -179,40 +180,6 @@ bool CheckPoints3DBinary(const fs::path& file, std::string* error) {
                             "a point's track");
       },
       error);
-}
-
-// References between cameras, images and points that the rest of the
-// program follows without checking (COLMAP's accessors throw or abort).
-bool CheckReferences(const std::string& path, const colmap::Reconstruction& map,
-                     std::string* error) {
-  const std::string prefix = "the map in " + path + " is inconsistent: ";
-  for (const auto& [image_id, image] : map.Images()) {
-    if (!map.ExistsCamera(image.CameraId())) {
-      *error = prefix + "image " + image.Name() + " refers to camera " +
-               std::to_string(image.CameraId()) + ", which is not in it";
-      return false;
-    }
-    for (const colmap::Point2D& point2D : image.Points2D()) {
-      if (point2D.HasPoint3D() && !map.ExistsPoint3D(point2D.Point3DId())) {
-        *error = prefix + "image " + image.Name() + " observes point " +
-                 std::to_string(point2D.Point3DId()) + ", which is not in it";
-        return false;
-      }
-    }
-  }
-  for (const auto& [point3D_id, point3D] : map.Points3D()) {
-    for (const colmap::TrackElement& element : point3D.Track().Elements()) {
-      if (!map.ExistsImage(element.image_id) ||
-          element.point2D_idx >= map.Image(element.image_id).NumPoints2D()) {
-        *error = prefix + "the track of point " + std::to_string(point3D_id) +
-                 " refers to image " + std::to_string(element.image_id) +
-                 ", point " + std::to_string(element.point2D_idx) +
-                 ", which is not in it";
-        return false;
-      }
-    }
-  }
-  return true;
 }
 
 // A folder under the system's temporary folder, removed with its contents
@@ -475,12 +442,14 @@ bool ReadModel(const std::string& path, colmap::Reconstruction* map,
              : !CheckImagesText(folder / "images.txt", error)) {
     return false;
   }
+  MapRepairs repairs;
   if (!ReadWithColmap(folder, binary, cameras, map, info, error) ||
       !CheckUniqueModelIds(path, binary, *map, error) ||
-      !CheckReferences(path, *map, error) ||
+      !CheckMapConsistency(path, binary, map, &repairs, error) ||
       !ReadMapRigsAndFrames(path, binary, *map, info, error)) {
     return false;
   }
+  if (repairs.Any()) info->warnings.push_back(repairs.Describe(path));
   return true;
 }
 

@@ -41,16 +41,20 @@ struct MapReadInfo {
   int num_frames = 0;
   // Lines for the log, about the above.
   std::vector<std::string> notes;
+  // What the user should fix in the map's files: repairs of inconsistencies
+  // made in memory (map_consistency.h).
+  std::vector<std::string> warnings;
 };
 
 // Reads the model in folder `path` (cameras, images, points3D as .bin, else
 // .txt; rigs and frames if present). Fails with a message if the folder or a
 // file is missing or unreadable, a binary file's records do not fit its size
 // exactly, a camera model is unknown to every COLMAP up to 4.1 or has the
-// wrong number of parameters, a text file does not parse, an id repeats,
-// images, cameras and points refer to each other inconsistently, the rigs and
-// frames disagree with the images, or the model has no registered image or no
-// 3D point.
+// wrong number of parameters, a text file does not parse, an id repeats, a
+// camera or an image pose is invalid (map_consistency.h), the rigs and frames
+// disagree with the images, or the model has no registered image or no 3D
+// point. Observations and tracks that do not confirm each other are repaired
+// in `map` and counted in info->warnings (map_consistency.h).
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,
              MapReadInfo* info, std::string* error);
 bool ReadMap(const std::string& path, colmap::Reconstruction* map,

@@ -9,12 +9,11 @@
 namespace rig_calibrator {
 
 double ObservationError(const colmap::Reconstruction& model,
-                        colmap::image_t image_id,
-                        colmap::point2D_t point2D_idx) {
-  const colmap::Image& image = model.Image(image_id);
-  const colmap::Point2D& point2D = image.Point2D(point2D_idx);
+                        const colmap::Point3D& point3D,
+                        const colmap::TrackElement& element) {
+  const colmap::Image& image = model.Image(element.image_id);
   const double squared_error = colmap::CalculateSquaredReprojectionError(
-      point2D.XY(), model.Point3D(point2D.Point3DId()).XYZ(), image.Qvec(),
+      image.Point2D(element.point2D_idx).XY(), point3D.XYZ(), image.Qvec(),
       image.Tvec(), model.Camera(image.CameraId()));
   return squared_error == std::numeric_limits<double>::max()
              ? std::numeric_limits<double>::infinity()
@@ -31,8 +30,7 @@ ReprojectionStats ComputeReprojectionStats(
       if (!image_ids.empty() && image_ids.count(element.image_id) == 0) {
         continue;
       }
-      const double error =
-          ObservationError(model, element.image_id, element.point2D_idx);
+      const double error = ObservationError(model, point3D, element);
       ++stats.num_observations;
       sum += error;
       stats.max_px = std::max(stats.max_px, error);
@@ -52,7 +50,7 @@ void RecomputePointErrors(
     int num_observations = 0;
     for (const colmap::TrackElement& element : point3D.Track().Elements()) {
       if (excluded_image_ids.count(element.image_id) > 0) continue;
-      sum += ObservationError(*model, element.image_id, element.point2D_idx);
+      sum += ObservationError(*model, point3D, element);
       ++num_observations;
     }
     if (num_observations > 0) {

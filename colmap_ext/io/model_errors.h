@@ -19,11 +19,14 @@ struct ReprojectionStats {
   int64_t num_above_4px = 0;
 };
 
-// The reprojection error of observation (image_id, point2D_idx) of a point
-// of `model` (infinite behind the camera).
+// The reprojection error of `point3D`'s observation `element` (infinite
+// behind the camera). The point is the track's own, not the one the image's
+// point2D names: on a model read from files the two can differ
+// (map_consistency.h repairs that on reading), and the track is what the
+// error belongs to. The element's image and point2D must be in `model`.
 double ObservationError(const colmap::Reconstruction& model,
-                        colmap::image_t image_id,
-                        colmap::point2D_t point2D_idx);
+                        const colmap::Point3D& point3D,
+                        const colmap::TrackElement& element);
 
 // Over every observation of a point by the images in `image_ids` (all
 // registered images if empty).

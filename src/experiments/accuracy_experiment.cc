@@ -206,8 +206,11 @@ std::string FormatAccuracyPaperTable(const std::vector<AccuracyRun>& runs) {
                        : "")
             << " | " << measure.name << " |";
       for (const CalibrationMethod method : methods) {
+        // C++17 lambdas cannot capture structured bindings (clang refuses;
+        // the fuzz build compiles this file with clang): init-captures.
         const auto run = std::find_if(
-            runs.begin(), runs.end(), [&](const AccuracyRun& candidate) {
+            runs.begin(), runs.end(),
+            [&, &preset = preset, &scene = scene](const AccuracyRun& candidate) {
               return candidate.preset == preset && candidate.scene == scene &&
                      candidate.method == method;
             });

@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 
 #include "tests/fuzz/database_reads.h"
 #include "tests/fuzz/fuzz_files.h"
@@ -59,8 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }();
   (void)written;
   const std::string path = folder + "/database.db";
-  std::filesystem::copy_file(folder + "/valid.db", path,
-                             std::filesystem::copy_options::overwrite_existing);
+  fuzz::CopyFile(folder + "/valid.db", path);
   sqlite3* database = nullptr;
   if (sqlite3_open(path.c_str(), &database) != SQLITE_OK) std::abort();
   Execute(database, data, size);

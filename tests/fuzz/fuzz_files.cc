@@ -41,5 +41,12 @@ std::string WriteScratchFile(const std::string& name, const uint8_t* data,
   return path;
 }
 
+void CopyFile(const std::string& from, const std::string& to) {
+  std::ifstream source(from, std::ios::binary);
+  std::ofstream target(to, std::ios::binary | std::ios::trunc);
+  target << source.rdbuf();
+  if (!source || !target) std::abort();
+}
+
 }  // namespace fuzz
 }  // namespace rig_calibrator

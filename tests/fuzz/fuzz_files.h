@@ -22,5 +22,11 @@ inline std::string WriteScratchFile(const std::string& name,
                           bytes.size());
 }
 
+// Copies the file `from` to `to` (overwriting it) through streams. Not
+// std::filesystem::copy_file: its sendfile() fails with EINTR when
+// libFuzzer's timer signal (-timeout) arrives during the copy, which ended a
+// model_fuzzer run with an uncaught filesystem_error.
+void CopyFile(const std::string& from, const std::string& to);
+
 }  // namespace fuzz
 }  // namespace rig_calibrator

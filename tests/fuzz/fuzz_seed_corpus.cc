@@ -2,6 +2,7 @@
 // committed) from the valid inputs of fuzz_templates.h, written by the
 // project's own writers and COLMAP's:
 //   fuzz_seed_corpus tests/fuzz/corpus
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "colmap_ext/io/rig_config_io.h"
 #include "tests/fuzz/fuzz_files.h"
 #include "tests/fuzz/fuzz_templates.h"
+#include "tests/fuzz/pipeline_case.h"
 
 namespace {
 
@@ -122,6 +124,17 @@ int main(int argc, char** argv) {
   Put(corpus, "database_blob", "descriptors", blob_seed(1, 3, 128, 3 * 128));
   Put(corpus, "database_blob", "matches", blob_seed(2, 2, 2, 2 * 2 * 4));
   Put(corpus, "database_blob", "camera", blob_seed(3, 2, 64, 4 * 8));
+  // The whole-pipeline case's files (pipeline_fuzzer.cc's selector, then
+  // the file).
+  const std::string pipeline = scratch + "/pipeline";
+  fuzz::WritePipelineCase(pipeline);
+  const std::vector<std::string>& pipeline_files = fuzz::PipelineCaseFiles();
+  for (size_t i = 0; i < pipeline_files.size(); ++i) {
+    std::string name = pipeline_files[i];
+    std::replace(name.begin(), name.end(), '/', '_');
+    Put(corpus, "pipeline", name,
+        Selected(static_cast<int>(i), pipeline + "/" + pipeline_files[i]));
+  }
   std::cout << "fuzz_seed_corpus: wrote the seeds into " << corpus << "\n";
   return 0;
 }

@@ -51,8 +51,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   colmap::Reconstruction map;
   std::string error;
   if (!ReadMap(folder, &map, &error) && error.empty()) std::abort();
-  std::filesystem::copy_file(folder + "_valid/" + kFiles[file],
-                             folder + "/" + kFiles[file],
-                             std::filesystem::copy_options::overwrite_existing);
+  fuzz::CopyFile(folder + "_valid/" + kFiles[file], folder + "/" + kFiles[file]);
   return 0;
 }

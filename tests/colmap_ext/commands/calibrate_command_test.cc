@@ -447,14 +447,19 @@ TEST_F(CalibrateCommandBadInput, NonColmapFilesAsModel) {
   ExpectFails(With(Arguments(), "--input_path", text_model_dir),
               {text_model_dir + "/cameras.txt line 1",
                "SIMPLE_RADIAL has 4 parameters, the line gives 3"});
-  // A point whose track names an image the model does not have.
+  // An image whose pose is not finite (map_consistency.h; tracks and
+  // observations that do not confirm each other are repaired instead,
+  // map_consistency_command_test.cc).
   WriteBytes(text_model_dir + "/cameras.txt",
              "1 SIMPLE_RADIAL 640 480 500 320 240 0\n");
-  std::ofstream(text_model_dir + "/points3D.txt", std::ios::app)
-      << "31 0 0 5 0 0 0 0.5 77 0\n";
+  std::string images_txt = testing::ReadBytes(text_model_dir + "/images.txt");
+  const size_t record = images_txt.find("\n1 ") + 1;
+  const size_t qw = images_txt.find(' ', record) + 1;
+  images_txt.replace(qw, images_txt.find(' ', qw) - qw, "nan");
+  WriteBytes(text_model_dir + "/images.txt", images_txt);
   ExpectFails(With(Arguments(), "--input_path", text_model_dir),
-              {"the map in " + text_model_dir + " is inconsistent",
-               "refers to image 77"});
+              {text_model_dir + "/images.txt: image map/0.png (id 1) has a "
+                                "pose that is not finite"});
 }
 
 }  // namespace
