@@ -18,16 +18,12 @@ CameraModelReport& CameraModelReportOf(const RigDataset& dataset,
   return report->camera_models[camera_index];
 }
 
-// The final inliers of camera `camera_index`, observed and projected through
-// the final calibration (refined map points where the map was refined), and
-// the image of each (the clusters of the ring check's standard error).
-void FinalInlierPixels(const RigDataset& dataset,
-                       const RigCalibration& calibration,
-                       const int camera_index,
-                       std::vector<Eigen::Vector2d>* observed,
-                       std::vector<Eigen::Vector2d>* projected,
-                       std::vector<int>* images) {
-  const colmap::Camera& camera = calibration.cameras[camera_index];
+// The final inliers of camera `camera_index`: observed pixels, points in
+// the rig frame (refined map points where the map was refined), framesets.
+AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
+                                  const RigCalibration& calibration,
+                                  const int camera_index) {
+  AdjustedCameraRows rows;
   for (size_t i = 0; i < dataset.images.size(); ++i) {
     const RigImage& image = dataset.images[i];
     const ImageResult& result = calibration.images[i];
@@ -35,8 +31,8 @@ void FinalInlierPixels(const RigDataset& dataset,
         !calibration.rig_from_world[image.frameset_index]) {
       continue;
     }
-    const Rigid3d cam_from_world =
-        calibration.CamFromWorld(camera_index, image.frameset_index);
+    const Rigid3d& rig_from_world =
+        *calibration.rig_from_world[image.frameset_index];
     for (size_t k = 0;
          k < image.correspondences.size() && k < result.inlier_mask.size();
          ++k) {
@@ -44,15 +40,36 @@ void FinalInlierPixels(const RigDataset& dataset,
       const Correspondence& correspondence = image.correspondences[k];
       const auto refined =
           calibration.refined_points3D.find(correspondence.point3D_id);
-      const Eigen::Vector3d point_cam =
-          cam_from_world * (refined != calibration.refined_points3D.end()
+      rows.points2D.push_back(correspondence.point2D);
+      rows.points_rig.push_back(
+          rig_from_world * (refined != calibration.refined_points3D.end()
                                 ? refined->second
-                                : correspondence.point3D);
-      if (!(point_cam.z() > 0)) continue;
-      observed->push_back(correspondence.point2D);
-      projected->push_back(camera.WorldToImage(point_cam.hnormalized()));
-      images->push_back(static_cast<int>(i));
+                                : correspondence.point3D));
+      rows.framesets.push_back(image.frameset_index);
     }
+  }
+  return rows;
+}
+
+// The same observed and projected through the final calibration, with the
+// frameset of each (one image of this camera: the clusters of the ring
+// check's standard error).
+void FinalInlierPixels(const RigDataset& dataset,
+                       const RigCalibration& calibration,
+                       const int camera_index,
+                       std::vector<Eigen::Vector2d>* observed,
+                       std::vector<Eigen::Vector2d>* projected,
+                       std::vector<int>* framesets) {
+  const colmap::Camera& camera = calibration.cameras[camera_index];
+  const AdjustedCameraRows rows =
+      AdjustedRowsOf(dataset, calibration, camera_index);
+  for (size_t r = 0; r < rows.points2D.size(); ++r) {
+    const Eigen::Vector3d point_cam =
+        calibration.cam_from_rig[camera_index] * rows.points_rig[r];
+    if (!(point_cam.z() > 0)) continue;
+    observed->push_back(rows.points2D[r]);
+    projected->push_back(camera.WorldToImage(point_cam.hnormalized()));
+    framesets->push_back(rows.framesets[r]);
   }
 }
 
@@ -202,41 +219,6 @@ void ChooseCameraModelsFromPoses(const PipelineOptions& options,
   }
 }
 
-namespace {
-
-// One camera's final inliers for the model choice on the adjusted rig.
-AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
-                                  const RigCalibration& calibration,
-                                  const int camera_index) {
-  AdjustedCameraRows rows;
-  for (size_t i = 0; i < dataset.images.size(); ++i) {
-    const RigImage& image = dataset.images[i];
-    const ImageResult& result = calibration.images[i];
-    if (image.camera_index != camera_index || !result.used ||
-        !calibration.rig_from_world[image.frameset_index]) {
-      continue;
-    }
-    const Rigid3d& rig_from_world =
-        *calibration.rig_from_world[image.frameset_index];
-    for (size_t k = 0;
-         k < image.correspondences.size() && k < result.inlier_mask.size();
-         ++k) {
-      if (!result.inlier_mask[k]) continue;
-      const Correspondence& correspondence = image.correspondences[k];
-      const auto refined =
-          calibration.refined_points3D.find(correspondence.point3D_id);
-      rows.points2D.push_back(correspondence.point2D);
-      rows.points_rig.push_back(
-          rig_from_world * (refined != calibration.refined_points3D.end()
-                                ? refined->second
-                                : correspondence.point3D));
-      rows.framesets.push_back(image.frameset_index);
-    }
-  }
-  return rows;
-}
-
-}  // namespace
 
 bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
                                      const CalibrationMethod method,

@@ -175,30 +175,11 @@ TEST(ModelChoiceAfterAdjustment, FisheyeLensGetsAFisheyeModel) {
   EXPECT_LT(outcome.projection.mean_projection_diff_px, 0.3);
 }
 
-// A lens beyond 90 degrees at the corners, which no COLMAP model can
-// represent: no candidate is compared with the current model, nothing
-// changes.
-TEST(ModelChoiceAfterAdjustment, NoChangeWhenTheCurrentModelIsNotValid) {
-  const colmap::Camera truth = MakeCamera(
-      "OPENCV_FISHEYE", 800, 800, {280, 280, 400, 400, 0.05, -0.01, 0.002, 0});
-  const AdjustedCameraRows rows = MakeRows(truth, 20, 150, 0.5, 0.1, 7);
-  colmap::Camera camera = StartCamera("RADIAL_FISHEYE", truth);
-  const colmap::Camera start = camera;
-  Rigid3d cam_from_rig = StartPose();
-  ModelChoice choice;
-  EXPECT_FALSE(ChooseModelOnAdjustedRig(ModelChoiceAfterAdjustmentOptions(),
-                                        rows, &camera, &cam_from_rig, &choice));
-  EXPECT_EQ(camera.Params(), start.Params());
-  EXPECT_EQ(choice.chosen, "");
-  EXPECT_NE(choice.reason.find("RADIAL_FISHEYE, was not valid"),
-            std::string::npos)
-      << choice.reason;
-}
-
-TEST(ModelChoiceAfterAdjustment, OneFramesetIsNoChoice) {
-  const colmap::Camera euroc_like = EurocLike();
-  const AdjustedCameraRows rows = MakeRows(euroc_like, 1, 300, 0, 0, 6);
-  colmap::Camera camera = StartCamera("RADIAL", euroc_like);
+// No choice (false) from `start_model`, the camera and pose unchanged,
+// and the reason containing `reason`.
+void ExpectNoChoice(const colmap::Camera& truth, const std::string& start_model,
+                    const AdjustedCameraRows& rows, const std::string& reason) {
+  colmap::Camera camera = StartCamera(start_model, truth);
   const colmap::Camera start = camera;
   Rigid3d cam_from_rig = StartPose();
   ModelChoice choice;
@@ -206,7 +187,25 @@ TEST(ModelChoiceAfterAdjustment, OneFramesetIsNoChoice) {
                                         rows, &camera, &cam_from_rig, &choice));
   EXPECT_EQ(camera.ModelName(), start.ModelName());
   EXPECT_EQ(camera.Params(), start.Params());
-  EXPECT_NE(choice.reason.find("one frameset"), std::string::npos);
+  EXPECT_EQ(cam_from_rig.translation, StartPose().translation);
+  EXPECT_EQ(choice.chosen, "");
+  EXPECT_NE(choice.reason.find(reason), std::string::npos) << choice.reason;
+}
+
+// A lens beyond 90 degrees at the corners, which no COLMAP model can
+// represent: no candidate is compared with the current model, nothing
+// changes.
+TEST(ModelChoiceAfterAdjustment, NoChangeWhenTheCurrentModelIsNotValid) {
+  const colmap::Camera truth = MakeCamera(
+      "OPENCV_FISHEYE", 800, 800, {280, 280, 400, 400, 0.05, -0.01, 0.002, 0});
+  ExpectNoChoice(truth, "RADIAL_FISHEYE", MakeRows(truth, 20, 150, 0.5, 0.1, 7),
+                 "RADIAL_FISHEYE, was not valid");
+}
+
+TEST(ModelChoiceAfterAdjustment, OneFramesetIsNoChoice) {
+  const colmap::Camera euroc_like = EurocLike();
+  ExpectNoChoice(euroc_like, "RADIAL", MakeRows(euroc_like, 1, 300, 0, 0, 6),
+                 "one frameset");
 }
 
 // Candidate 1 (more parameters) beats candidate 0 by 0.02 px^2 per row on

@@ -67,6 +67,23 @@ FinalBundleAdjustmentOptions MapAdjustment() {
   return options;
 }
 
+// A ring5 rig with a 24-image map and no wrong matches, adjusted from the
+// truth with the map (MapAdjustment), and its uncertainty.
+void AdjustWithTheMap(unsigned seed, SyntheticRig* rig,
+                      RigCalibration* calibration,
+                      CalibrationUncertainty* uncertainty) {
+  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, seed);
+  options.num_map_images = 24;
+  options.outlier_ratio = 0;
+  *rig = GenerateSyntheticRig(options);
+  KeepCorrespondencesWithMapTracks(rig);
+  *calibration = StartAtTruth(*rig);
+  ASSERT_TRUE(AdjustRig(MapAdjustment(), rig->dataset, calibration, nullptr));
+  *uncertainty =
+      EstimateCalibrationUncertainty(MapAdjustment(), rig->dataset, *calibration);
+  ASSERT_TRUE(uncertainty->computed) << uncertainty->message;
+}
+
 bool AllFinite(const CameraUncertainty& camera) {
   bool finite = camera.covariance.allFinite() &&
                 std::isfinite(camera.rotation_stddev_deg) &&
@@ -174,17 +191,12 @@ TEST(CalibrationUncertainty, ExactDataGiveZeroSigmaAndNoNaN) {
 // point (7 gauge directions, 3 pinned): a singular system and no
 // uncertainty, as on a real map (infrascal_ring, 10 held-out timestamps).
 TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
-  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
-  options.num_map_images = 24;
-  options.outlier_ratio = 0;
-  SyntheticRig rig = GenerateSyntheticRig(options);
-  KeepCorrespondencesWithMapTracks(&rig);
+  SyntheticRig rig;
+  RigCalibration calibration;
+  CalibrationUncertainty reference;
+  AdjustWithTheMap(6, &rig, &calibration, &reference);
+  if (HasFatalFailure()) return;
   const FinalBundleAdjustmentOptions ba = MapAdjustment();
-  RigCalibration calibration = StartAtTruth(rig);
-  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
-  const CalibrationUncertainty reference =
-      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
-  ASSERT_TRUE(reference.computed) << reference.message;
 
   // One more correspondence in the first image: a point of its own, exact.
   RigImage& image = rig.dataset.images[0];
@@ -223,17 +235,12 @@ TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
 // singular there, as on the real EuRoC pair. The image is left out, the
 // uncertainty computed and the image named, the rig's sigma as without it.
 TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
-  SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 7);
-  options.num_map_images = 24;
-  options.outlier_ratio = 0;
-  SyntheticRig rig = GenerateSyntheticRig(options);
-  KeepCorrespondencesWithMapTracks(&rig);
+  SyntheticRig rig;
+  RigCalibration calibration;
+  CalibrationUncertainty reference;
+  AdjustWithTheMap(7, &rig, &calibration, &reference);
+  if (HasFatalFailure()) return;
   const FinalBundleAdjustmentOptions ba = MapAdjustment();
-  RigCalibration calibration = StartAtTruth(rig);
-  ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
-  const CalibrationUncertainty reference =
-      EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
-  ASSERT_TRUE(reference.computed) << reference.message;
 
   MapImage sparse = rig.dataset.map_images[0];
   sparse.name = "sparse.png";
