@@ -58,9 +58,9 @@ struct ModelChoiceAfterAdjustmentOptions {
   double significance = 2.0;  // z of the one-standard-error rule
   // The fits and the held-out errors use at most this many of the camera's
   // inliers (a fixed random subset).
-  int max_num_rows = 4000;
+  int max_num_rows = 2500;
   int max_num_iterations = 50;       // the full fit of a candidate
-  int max_num_fold_iterations = 20;  // a fold's refit, from the full fit
+  int max_num_fold_iterations = 10;  // a fold's refit, from the full fit
   double loss_scale_px = 1.0;        // Cauchy scale of the fits
   // A held-out squared error is truncated at max_error_px^2, so that the few
   // wrong correspondences left do not decide.
