@@ -242,6 +242,7 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
   choice_options.loss_scale_px = ba_options.loss_scale_px;
   choice_options.max_error_px = options.upgrade.max_error_px;
   choice_options.validity = options.model_selection.validity;
+  choice_options.min_num_framesets = options.model_selection.min_num_framesets;
 
   // The cameras' choices are independent: one thread each, the results
   // applied in camera order below (the same whatever the thread count).

@@ -318,7 +318,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
       }
     }
   }
-  const int chosen = ChooseByHeldOutError(
+  int chosen = ChooseByHeldOutError(
       options.significance, squared_errors, clusters,
       std::to_string(subset.size()) + " final inliers, " +
           std::to_string(num_folds) +
@@ -347,6 +347,22 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
     for (ModelCandidate& candidate : choice->candidates) candidate.chosen = false;
     choice->chosen.clear();
     return false;
+  }
+  const int current_index =
+      static_cast<int>(current - choice->candidates.begin());
+  if (static_cast<int>(framesets.size()) < options.min_num_framesets &&
+      chosen != current_index && current->as_good_as_best) {
+    choice->candidates[chosen].chosen = false;
+    chosen = current_index;
+    current->chosen = true;
+    choice->chosen = current->model;
+    choice->reason = current->model + " kept: with " +
+                     std::to_string(framesets.size()) +
+                     " framesets (fewer than " +
+                     std::to_string(options.min_num_framesets) +
+                     ") a simpler model replaces it only when its held-out "
+                     "error is worse than the best, and it is not (the rule "
+                     "alone: " + choice->reason + ")";
   }
   *camera = fits[chosen].camera;
   *cam_from_rig = fits[chosen].cam_from_rig;

@@ -554,6 +554,7 @@ int ChooseByHeldOutError(double significance,
     const bool as_good =
         mean_difference <= significance * standard_error + kMinMseDifference;
     ModelCandidate& candidate = choice->candidates[m];
+    candidate.as_good_as_best = as_good;
     if (static_cast<int>(m) != best) {
       candidate.note = std::string(as_good ? "as good as" : "worse than") +
                        " the best (mean squared error +" +

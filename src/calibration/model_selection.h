@@ -95,6 +95,9 @@ struct ModelCandidate {
   // 0 unless valid; NaN when valid but not compared held out.
   double heldout_rms_px = 0;
   bool chosen = false;
+  // Compared held out and within the rule's standard errors of the best
+  // (the best included).
+  bool as_good_as_best = false;
   std::string note;  // why dropped, or how it compares with the best
 };
 

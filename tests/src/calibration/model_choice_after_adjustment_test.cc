@@ -208,6 +208,24 @@ TEST(ModelChoiceAfterAdjustment, OneFramesetIsNoChoice) {
                  "one frameset");
 }
 
+// Four framesets: a lens with one focal length and no tangential distortion
+// (RADIAL) seen by a camera whose current model is OPENCV. RADIAL is as good
+// held out, but four clusters do not make that sure, and OPENCV is kept;
+// with twenty framesets RADIAL wins.
+TEST(ModelChoiceAfterAdjustment, FewFramesetsKeepTheCurrentModelUnlessItIsWorse) {
+  const colmap::Camera truth = MakeCamera(
+      "OPENCV", 752, 480, {458.0, 458.0, 367.2, 248.4, -0.283, 0.074, 0, 0});
+  const Outcome few =
+      Choose(truth, StartCamera("OPENCV", truth), MakeRows(truth, 4, 300, 0.5, 0, 8));
+  EXPECT_EQ(few.choice.chosen, "OPENCV");
+  EXPECT_NE(few.choice.reason.find("OPENCV kept: with 4 framesets"),
+            std::string::npos)
+      << few.choice.reason;
+  const Outcome many =
+      Choose(truth, StartCamera("OPENCV", truth), MakeRows(truth, 20, 150, 0.5, 0, 8));
+  EXPECT_EQ(many.choice.chosen, "RADIAL") << many.choice.reason;
+}
+
 // Candidate 1 (more parameters) beats candidate 0 by 0.02 px^2 per row on
 // average, but per frameset the difference is +-0.1: as independent rows
 // (1000 of them) that is 6 standard errors, clustered by the 10 framesets
