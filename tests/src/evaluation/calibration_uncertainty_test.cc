@@ -95,6 +95,24 @@ bool AllFinite(const CameraUncertainty& camera) {
   return finite;
 }
 
+// Every camera's sigma finite and, in rotation and centre, within 5 % of
+// the reference's.
+void ExpectSameSigma(const CalibrationUncertainty& uncertainty,
+                     const CalibrationUncertainty& reference) {
+  ASSERT_EQ(uncertainty.cameras.size(), reference.cameras.size());
+  for (size_t c = 0; c < uncertainty.cameras.size(); ++c) {
+    const CameraUncertainty& camera = uncertainty.cameras[c];
+    ASSERT_TRUE(camera.computed && camera.determined);
+    EXPECT_TRUE(AllFinite(camera));
+    EXPECT_NEAR(camera.rotation_stddev_deg,
+                reference.cameras[c].rotation_stddev_deg,
+                0.05 * reference.cameras[c].rotation_stddev_deg + 1e-9);
+    EXPECT_NEAR(camera.center_in_rig_stddev.norm(),
+                reference.cameras[c].center_in_rig_stddev.norm(),
+                0.05 * reference.cameras[c].center_in_rig_stddev.norm() + 1e-9);
+  }
+}
+
 // Normalized errors (true error / reported sigma) of a group of quantities.
 struct NormalizedErrors {
   std::vector<double> values;
@@ -216,18 +234,8 @@ TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
       EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
   ASSERT_TRUE(uncertainty.computed) << uncertainty.message;
   EXPECT_TRUE(uncertainty.free_gauge);
-  for (size_t c = 0; c < uncertainty.cameras.size(); ++c) {
-    const CameraUncertainty& camera = uncertainty.cameras[c];
-    ASSERT_TRUE(camera.computed && camera.determined);
-    EXPECT_TRUE(AllFinite(camera));
-    // The same data but one uninformative observation: the same sigma.
-    EXPECT_NEAR(camera.rotation_stddev_deg,
-                reference.cameras[c].rotation_stddev_deg,
-                0.05 * reference.cameras[c].rotation_stddev_deg + 1e-9);
-    EXPECT_NEAR(camera.center_in_rig_stddev.norm(),
-                reference.cameras[c].center_in_rig_stddev.norm(),
-                0.05 * reference.cameras[c].center_in_rig_stddev.norm() + 1e-9);
-  }
+  // The same data but one uninformative observation: the same sigma.
+  ExpectSameSigma(uncertainty, reference);
 }
 
 // A map image that sees two refined points: the adjustment moves its pose
@@ -263,14 +271,7 @@ TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
   EXPECT_NE(uncertainty.method.find("1 map image(s)"), std::string::npos)
       << uncertainty.method;
   EXPECT_NE(uncertainty.method.find("sparse.png"), std::string::npos);
-  for (size_t c = 0; c < uncertainty.cameras.size(); ++c) {
-    const CameraUncertainty& camera = uncertainty.cameras[c];
-    ASSERT_TRUE(camera.computed && camera.determined);
-    EXPECT_TRUE(AllFinite(camera));
-    EXPECT_NEAR(camera.rotation_stddev_deg,
-                reference.cameras[c].rotation_stddev_deg,
-                0.05 * reference.cameras[c].rotation_stddev_deg + 1e-9);
-  }
+  ExpectSameSigma(uncertainty, reference);
 }
 
 // "framesets_disagree" names the camera whose between-framesets sigma is
