@@ -59,12 +59,16 @@ def die(message):
 # ---------------------------------------------------------------------------
 # COLMAP text model.
 
+def records(path):
+    """The fields of every line of a COLMAP text file that is no comment."""
+    for line in open(path):
+        if not line.startswith("#") and line.strip():
+            yield line.split()
+
+
 def read_cameras(path):
     cameras = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        f = line.split()
+    for f in records(path):
         cameras[int(f[0])] = {"model": f[1], "width": int(f[2]),
                               "height": int(f[3]),
                               "params": [float(x) for x in f[4:]]}
@@ -90,10 +94,7 @@ def read_images(path):
 
 def read_points(path):
     points = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        f = line.split()
+    for f in records(path):
         track = [(int(f[i]), int(f[i + 1])) for i in range(8, len(f) - 1, 2)]
         points[int(f[0])] = {"xyz": [float(x) for x in f[1:4]],
                              "rgb": f[4:7], "error": f[7], "track": track}
