@@ -44,9 +44,7 @@ CalibrationSummary MakeCalibrationSummary(
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);
   }
-  for (const StageTiming& timing : report.timings) {
-    summary.timings_s.emplace_back(timing.stage, timing.seconds);
-  }
+  summary.timings = report.timings;
   SetCoverageSummary(report, &summary);
   return summary;
 }

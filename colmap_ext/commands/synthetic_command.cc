@@ -4,6 +4,7 @@
 #include <boost/filesystem.hpp>
 #include <iostream>
 
+#include "colmap_ext/benchmarks/synthetic_map_model.h"
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/atomic_output.h"
@@ -60,6 +61,19 @@ int RunSynthetic(int argc, char** argv) {
             "the rig only rotates about a fixed point");
   AddOption(&description, "map_scale", &options.map_scale,
             "map units per metre (1000: a map in millimetres)");
+  AddOption(&description, "ring_num_cameras", &options.ring_num_cameras,
+            "ring5 only: that many cameras on the ring (0: 5)");
+  AddOption(&description, "num_map_images", &options.num_map_images,
+            "map images: > 0 writes the map as a COLMAP model (sparse/, "
+            "with the map images' observations) and the correspondences "
+            "with its point ids");
+  AddOption(&description, "map_observations_per_image",
+            &options.map_observations_per_image,
+            "at most this many observations per map image (0: all visible)");
+  AddOption(&description, "map_noise_px", &options.map_noise_px,
+            "pixel noise of the map images' observations");
+  AddOption(&description, "map_point_noise", &options.map_point_noise,
+            "error of the map points (map units per coordinate)");
   AddOption(&description, "seed", &seed, "random seed");
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(
@@ -88,9 +102,14 @@ int RunSynthetic(int argc, char** argv) {
       [&](const std::string& folder, std::string* write_error) {
         std::vector<std::string> notes;
         boost::filesystem::create_directories(folder + "/ground_truth");
-        return WriteCorrespondenceFile(folder + "/correspondences.txt",
-                                       DatasetCorrespondences(rig.dataset),
-                                       write_error) &&
+        const bool data_written =
+            options.num_map_images > 0
+                ? WriteSyntheticMapModel(MakeSyntheticMapModel(rig), folder,
+                                         /*binary=*/true, write_error)
+                : WriteCorrespondenceFile(folder + "/correspondences.txt",
+                                          DatasetCorrespondences(rig.dataset),
+                                          write_error);
+        return data_written &&
                WriteRigConfigJson(folder + "/ground_truth/rig_config.json",
                                   truth, write_error) &&
                WriteCamchainYaml(folder + "/ground_truth/camchain.yaml", truth,
@@ -110,7 +129,11 @@ int RunSynthetic(int argc, char** argv) {
             << rig.dataset.frameset_names.size() << " framesets (" << preset
             << ") to " << output_path
             << "\nCalibrate with:\n  rig_calibrator --correspondences_path "
-            << output_path << "/correspondences.txt --output_path OUT "
+            << output_path << "/correspondences.txt "
+            << (options.num_map_images > 0
+                    ? "--input_path " + output_path + "/sparse "
+                    : std::string())
+            << "--output_path OUT "
             << "--RigCalibrator.camera_model " << models
             << "\nEvaluate with:\n  rig_calibrator evaluate --reference_path "
             << output_path

@@ -190,12 +190,19 @@ bool WriteCalibrationSummaryJson(const std::string& path,
 
 bool WriteTimingsJson(const std::string& path,
                       const CalibrationSummary& summary, std::string* error) {
-  Json timings = Json::object();
-  for (const auto& [stage, seconds] : summary.timings_s) {
-    timings[stage] = Number(seconds);
+  Json timings = Json::object(), cpu = Json::object(),
+       iterations = Json::object();
+  for (const StageTiming& timing : summary.timings) {
+    timings[timing.stage] = Number(timing.seconds);
+    cpu[timing.stage] = Number(timing.cpu_seconds);
+    if (timing.num_iterations > 0) {
+      iterations[timing.stage] = timing.num_iterations;
+    }
   }
   Json root;
   root["timings_s"] = timings;
+  root["cpu_s"] = cpu;
+  root["iterations"] = iterations;
   return WriteJson(path, root, error);
 }
 

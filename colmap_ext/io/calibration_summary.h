@@ -16,6 +16,7 @@
 
 #include "src/calibration/camera_model_report.h"
 #include "src/calibration/intrinsics_refinement.h"
+#include "src/calibration/stage_timing.h"
 #include "src/calibration/rig_dataset.h"
 #include "src/evaluation/calibration_uncertainty.h"
 #include "src/evaluation/image_coverage.h"
@@ -92,8 +93,9 @@ struct CalibrationSummary {
   std::string known_rig_reference_camera;
   std::vector<KnownPoseComparison> known_rig_comparison;
   std::vector<std::string> diagnostics;  // warnings and notes, in order
-  // Stage, wall seconds: written by WriteTimingsJson only.
-  std::vector<std::pair<std::string, double>> timings_s;
+  // Per stage: wall and CPU seconds, solver iterations; written by
+  // WriteTimingsJson only.
+  std::vector<StageTiming> timings;
   std::optional<MapImagesSummary> map_images;  // with a map
   CalibrationUncertainty uncertainty;          // of the pipeline's report
 };
@@ -117,7 +119,9 @@ bool WriteCalibrationSummaryJson(const std::string& path,
                                  const CalibrationSummary& summary,
                                  std::string* error);
 
-// {"timings_s": {stage: seconds, ...}}.
+// {"timings_s": {stage: wall seconds, ...}, "cpu_s": {stage: CPU seconds of
+// all threads, ...}, "iterations": {stage: solver iterations, ...}} (the
+// last for the stages with a bundle adjustment).
 bool WriteTimingsJson(const std::string& path,
                       const CalibrationSummary& summary, std::string* error);
 

@@ -224,8 +224,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
   }
 
   std::vector<Fit> fits(options.candidate_models.size());
-  std::vector<std::vector<double>> squared_errors(fits.size());
-  std::vector<double> training_mse(fits.size(), 0);
+  std::vector<std::vector<double>> training_errors(fits.size());
   std::vector<int> clusters;
   for (const int row : subset) clusters.push_back(rows.framesets[row]);
   if (subset.empty()) {
@@ -261,12 +260,12 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
         CheckModelValidity(fit.camera, options.validity);
     candidate.valid = validity.valid;
     // The table's inliers and training RMS: the rows the fit leaves within
-    // max_error_px; training_mse: the truncated mean squared error.
+    // max_error_px; training_errors: the truncated squared errors, per row.
     double sum_squares = 0;
     for (const int row : subset) {
       const double squared_error = TruncatedSquaredError(
           fit, rows.points2D[row], rows.points_rig[row], options.max_error_px);
-      training_mse[m] += squared_error / subset.size();
+      if (validity.valid) training_errors[m].push_back(squared_error);
       if (squared_error < options.max_error_px * options.max_error_px) {
         sum_squares += squared_error;
         ++candidate.num_inliers;
@@ -279,25 +278,10 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
   }
 
   // Held out, fold k predicted by the full fit refitted without it, for the
-  // valid candidates whose training error is at most twice the least: a
-  // held-out error is no smaller than the training error, so the others
-  // cannot be as good as the best (and their folds are most of the cost).
-  double least_training_mse = std::numeric_limits<double>::infinity();
-  for (size_t m = 0; m < fits.size(); ++m) {
-    if (choice->candidates[m].valid) {
-      least_training_mse = std::min(least_training_mse, training_mse[m]);
-    }
-  }
-  for (size_t m = 0; m < fits.size(); ++m) {
-    ModelCandidate& candidate = choice->candidates[m];
-    if (!candidate.valid) continue;
-    if (training_mse[m] > 2 * least_training_mse + kMinMseDifference) {
-      candidate.note = "worse than the best: its training error alone is "
-                       "more than twice the least";
-      candidate.heldout_rms_px = std::numeric_limits<double>::quiet_NaN();
-      continue;
-    }
-    squared_errors[m].assign(subset.size(), 0);
+  // candidates that can still be as good as the best (the folds are most of
+  // the cost).
+  const auto held_out = [&](size_t m) {
+    std::vector<double> errors(subset.size(), 0);
     for (int fold = 0; fold < num_folds; ++fold) {
       std::vector<int> training;
       for (const int row : subset) {
@@ -312,12 +296,16 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
       for (size_t e = 0; e < subset.size(); ++e) {
         const int row = subset[e];
         if (fold_of_frameset[rows.framesets[row]] != fold) continue;
-        squared_errors[m][e] =
-            TruncatedSquaredError(fold_fit, rows.points2D[row],
-                                  rows.points_rig[row], options.max_error_px);
+        errors[e] = TruncatedSquaredError(fold_fit, rows.points2D[row],
+                                          rows.points_rig[row],
+                                          options.max_error_px);
       }
     }
-  }
+    return errors;
+  };
+  const std::vector<std::vector<double>> squared_errors =
+      HeldOutErrorsOfContenders(options.significance, training_errors,
+                                clusters, held_out, choice);
   int chosen = ChooseByHeldOutError(
       options.significance, squared_errors, clusters,
       std::to_string(subset.size()) + " final inliers, " +

@@ -320,17 +320,28 @@ bool SelectCameraModelOnRows(const ModelSelectionOptions& options,
     return false;
   }
 
-  std::vector<std::vector<double>> squared_errors(fits.size());
-  for (size_t m = 0; m < fits.size(); ++m) {
-    if (!choice->candidates[m].valid) continue;
-    squared_errors[m] =
-        HeldOutSquaredErrors(options, upgrade_options, fits[m], points2D,
-                             points_cam, groups, subset, evaluation_rows);
-  }
   // Every row its own cluster: the upgrade's rows are compared as
   // independent (its poses are the upgrade's, not yet adjusted).
   std::vector<int> clusters(evaluation_rows.size());
   std::iota(clusters.begin(), clusters.end(), 0);
+  std::vector<std::vector<double>> training_errors(fits.size());
+  for (size_t m = 0; m < fits.size(); ++m) {
+    if (!choice->candidates[m].valid) continue;
+    for (const int row : evaluation_rows) {
+      training_errors[m].push_back(TruncatedSquaredError(
+          fits[m].camera, fits[m].result.tz, points2D[row], points_cam[row],
+          upgrade_options.max_error_px));
+    }
+  }
+  const std::vector<std::vector<double>> squared_errors =
+      HeldOutErrorsOfContenders(
+          options.significance, training_errors, clusters,
+          [&](size_t m) {
+            return HeldOutSquaredErrors(options, upgrade_options, fits[m],
+                                        points2D, points_cam, groups, subset,
+                                        evaluation_rows);
+          },
+          choice);
   const int chosen = ChooseByHeldOutError(
       options.significance, squared_errors, clusters,
       std::to_string(evaluation_rows.size()) + " correspondences, " +
@@ -502,6 +513,42 @@ bool SelectCameraModel(const ModelSelectionOptions& options,
   return true;
 }
 
+namespace {
+
+// mean(d) and its standard error, d_i = a_i - b_i, clustered by `clusters`:
+// sqrt(G / (G - 1) sum_g (S_g - n_g mean(d))^2) / n over the G clusters (the
+// sample standard deviation / sqrt(n) when every row is its own cluster).
+struct PairedDifference {
+  double mean = 0, standard_error = 0;
+};
+PairedDifference ComparePaired(const std::vector<double>& a,
+                               const std::vector<double>& b,
+                               const std::vector<int>& clusters) {
+  std::map<int, std::pair<double, double>> sum_and_count;
+  double sum = 0;
+  for (size_t e = 0; e < clusters.size(); ++e) {
+    const double d = a[e] - b[e];
+    sum += d;
+    auto& [cluster_sum, cluster_count] = sum_and_count[clusters[e]];
+    cluster_sum += d;
+    cluster_count += 1;
+  }
+  PairedDifference difference;
+  const double n = clusters.size();
+  const double num_clusters = sum_and_count.size();
+  difference.mean = n > 0 ? sum / n : 0;
+  double spread = 0;
+  for (const auto& [cluster, sums] : sum_and_count) {
+    spread += std::pow(sums.first - sums.second * difference.mean, 2);
+  }
+  difference.standard_error =
+      num_clusters > 1 ? std::sqrt(num_clusters / (num_clusters - 1) * spread) / n
+                       : 0;
+  return difference;
+}
+
+}  // namespace
+
 int ChooseByHeldOutError(double significance,
                          const std::vector<std::vector<double>>& squared_errors,
                          const std::vector<int>& clusters,
@@ -516,41 +563,13 @@ int ChooseByHeldOutError(double significance,
     }
   }
   if (best < 0) return -1;
-  // Cluster sums of the paired differences d_i = e_m,i^2 - e_best,i^2: the
-  // standard error of mean(d) is sqrt(G / (G - 1) sum_g (S_g - n_g mean)^2)
-  // / n over the G clusters (the sample standard deviation / sqrt(n) when
-  // every row is its own cluster).
-  std::vector<int> cluster_index(clusters.size());
-  std::map<int, int> index_of_cluster;
-  for (size_t e = 0; e < clusters.size(); ++e) {
-    cluster_index[e] =
-        index_of_cluster.emplace(clusters[e], index_of_cluster.size())
-            .first->second;
-  }
-  const double num_clusters = index_of_cluster.size();
-  const double n = clusters.size();
   int chosen = best;
   for (size_t m = 0; m < num_candidates; ++m) {
     if (squared_errors[m].empty()) continue;
-    std::vector<double> cluster_sum(index_of_cluster.size(), 0);
-    std::vector<double> cluster_count(index_of_cluster.size(), 0);
-    double sum = 0;
-    for (size_t e = 0; e < clusters.size(); ++e) {
-      const double d = squared_errors[m][e] - squared_errors[best][e];
-      sum += d;
-      cluster_sum[cluster_index[e]] += d;
-      cluster_count[cluster_index[e]] += 1;
-    }
-    const double mean_difference = sum / n;
-    double spread = 0;
-    for (size_t g = 0; g < cluster_sum.size(); ++g) {
-      spread += std::pow(cluster_sum[g] - cluster_count[g] * mean_difference,
-                         2);
-    }
-    const double standard_error =
-        num_clusters > 1
-            ? std::sqrt(num_clusters / (num_clusters - 1) * spread) / n
-            : 0;
+    const PairedDifference difference =
+        ComparePaired(squared_errors[m], squared_errors[best], clusters);
+    const double mean_difference = difference.mean;
+    const double standard_error = difference.standard_error;
     const bool as_good =
         mean_difference <= significance * standard_error + kMinMseDifference;
     ModelCandidate& candidate = choice->candidates[m];
@@ -596,6 +615,45 @@ int ChooseByHeldOutError(double significance,
              : "as many parameters, earlier in the candidates' order");
   }
   return chosen;
+}
+
+std::vector<std::vector<double>> HeldOutErrorsOfContenders(
+    const double significance,
+    const std::vector<std::vector<double>>& training_errors,
+    const std::vector<int>& clusters,
+    const std::function<std::vector<double>(size_t)>& held_out,
+    ModelChoice* choice) {
+  std::vector<size_t> order;
+  for (size_t m = 0; m < training_errors.size(); ++m) {
+    if (!training_errors[m].empty()) order.push_back(m);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return Mean(training_errors[a]) < Mean(training_errors[b]);
+  });
+  std::vector<std::vector<double>> squared_errors(training_errors.size());
+  int best = -1;
+  for (const size_t m : order) {
+    if (best >= 0) {
+      const PairedDifference difference =
+          ComparePaired(training_errors[m], squared_errors[best], clusters);
+      if (difference.mean >
+          significance * difference.standard_error + kMinMseDifference) {
+        ModelCandidate& candidate = choice->candidates[m];
+        candidate.heldout_rms_px = std::numeric_limits<double>::quiet_NaN();
+        candidate.note =
+            "worse than the best on its training error alone (mean squared "
+            "error +" + Fixed(difference.mean, 5) +
+            " px^2 over the best's held-out, standard error " +
+            Fixed(difference.standard_error, 5) + "); not held out";
+        continue;
+      }
+    }
+    squared_errors[m] = held_out(m);
+    if (best < 0 || Mean(squared_errors[m]) < Mean(squared_errors[best])) {
+      best = static_cast<int>(m);
+    }
+  }
+  return squared_errors;
 }
 
 std::string FormatModelChoice(const ModelChoice& choice,

@@ -41,6 +41,7 @@
 #include <colmap/base/camera.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,24 @@ int ChooseByHeldOutError(double significance,
                          const std::vector<std::vector<double>>& squared_errors,
                          const std::vector<int>& clusters,
                          const std::string& evaluation, ModelChoice* choice);
+
+// The held-out squared errors (per evaluation row, as ChooseByHeldOutError
+// takes them) of the candidates that can still be as good as the best, the
+// others' left empty: held_out(m) computes candidate m's (its folds: most of
+// a choice's cost). training_errors[m]: per evaluation row, candidate m's
+// squared error under its fit to every row (empty: not valid). Candidates are
+// taken by increasing mean training error; one whose training error alone is
+// worse than the best held-out error so far by the choice rule (mean(d) >
+// significance SE(d) + kMinMseDifference, d = training - best held-out, SE
+// clustered as ChooseByHeldOutError's) is not held out: a held-out error is
+// no smaller than the training error of the same model (its fits never saw
+// the rows they predict), so the rule would find it worse than the best
+// anyway. Its note and heldout_rms_px (NaN) say so.
+std::vector<std::vector<double>> HeldOutErrorsOfContenders(
+    double significance, const std::vector<std::vector<double>>& training_errors,
+    const std::vector<int>& clusters,
+    const std::function<std::vector<double>(size_t)>& held_out,
+    ModelChoice* choice);
 
 // The candidates' table (one line each) and the reason, for the terminal.
 std::string FormatModelChoice(const ModelChoice& choice,

@@ -14,6 +14,7 @@
 #include "src/calibration/camera_model_report.h"
 #include "src/calibration/intrinsics_refinement.h"
 #include "src/calibration/rig_dataset.h"
+#include "src/calibration/stage_timing.h"
 #include "src/evaluation/calibration_uncertainty.h"
 #include "src/evaluation/image_coverage.h"
 
@@ -29,16 +30,6 @@ struct Diagnostic {
 };
 std::string DiagnosticLevelName(Diagnostic::Level level);
 
-struct StageTiming {
-  std::string stage;
-  double seconds = 0;  // wall time
-  // CPU time of the whole process (all threads, user + system) during the
-  // stage: unlike wall time, hardly affected by other work on the machine.
-  double cpu_seconds = 0;
-  // Solver iterations of the stage's bundle adjustment (Ceres steps over
-  // all its solves); 0 for stages without one.
-  int num_iterations = 0;
-};
 
 struct PipelineReport {
   CalibrationMethod requested_method = CalibrationMethod::kRadial1D;

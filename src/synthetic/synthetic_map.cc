@@ -4,6 +4,7 @@
 #include <colmap/base/triangulation.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 #include <unordered_map>
 
@@ -111,6 +112,20 @@ void TriangulateMapPoints(const RigDataset& dataset,
   }
 }
 
+// Keeps `count` of a map image's visible points (id, pixel): the rig's
+// points first, each group in a random order, then back in id order.
+void KeepObservations(int count, const std::vector<char>& rig_observed,
+                      std::mt19937* rng,
+                      std::vector<std::pair<int64_t, Eigen::Vector2d>>* visible) {
+  std::shuffle(visible->begin(), visible->end(), *rng);
+  std::stable_partition(visible->begin(), visible->end(), [&](const auto& v) {
+    return rig_observed[v.first] != 0;
+  });
+  visible->resize(count);
+  std::sort(visible->begin(), visible->end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+}
+
 }  // namespace
 
 void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
@@ -153,6 +168,19 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
   // The map's pose errors from a stream of their own: without them the
   // dataset is the same as before they existed.
   std::mt19937 pose_rng(options.seed + 2);
+  // The cap's draws from a stream of their own too; the points some rig image
+  // observes (correctly) come first, as a map holds what was matched.
+  std::mt19937 cap_rng(options.seed + 3);
+  std::vector<char> rig_observed;
+  if (options.map_observations_per_image > 0) {
+    rig_observed.assign(truth.size(), 0);
+    for (size_t i = 0; i < dataset.images.size(); ++i) {
+      for (size_t k = 0; k < dataset.images[i].correspondences.size(); ++k) {
+        if (rig->is_outlier[i][k]) continue;
+        rig_observed[dataset.images[i].correspondences[k].point3D_id] = 1;
+      }
+    }
+  }
   for (int m = 0; m < options.num_map_images; ++m) {
     const int c = m % num_cameras;
     const int j =
@@ -179,6 +207,7 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
     image.cam_from_world = MapPoseAsMapped(
         options, cam_from_world, rig->truth.rig_from_world[0].Center(), m,
         &pose_rng);
+    std::vector<std::pair<int64_t, Eigen::Vector2d>> visible;
     for (size_t id = 0; id < truth.size(); ++id) {
       const Eigen::Vector3d point_in_cam = cam_from_world * truth[id];
       if (point_in_cam.z() <= 0 ||
@@ -191,9 +220,16 @@ void AddSyntheticMap(const SyntheticRigOptions& options, SyntheticRig* rig) {
           xy.y() > camera.Height()) {
         continue;
       }
+      visible.emplace_back(static_cast<int64_t>(id), xy);
+    }
+    if (options.map_observations_per_image > 0 &&
+        static_cast<int>(visible.size()) > options.map_observations_per_image) {
+      KeepObservations(options.map_observations_per_image, rig_observed,
+                       &cap_rng, &visible);
+    }
+    for (const auto& [id, xy] : visible) {
       image.observations.push_back(
-          {AddPixelNoise(camera, xy, options.map_noise_px, &rng),
-           static_cast<int64_t>(id),
+          {AddPixelNoise(camera, xy, options.map_noise_px, &rng), id,
            static_cast<uint32_t>(image.observations.size())});
     }
     dataset.map_images.push_back(std::move(image));

@@ -222,6 +222,9 @@ bool SyntheticRigOptions::Check(std::string* error) const {
     message << "map_scale must be a positive number, got " << map_scale;
   } else if (!(feature_window > 0 && feature_window <= 1)) {
     message << "feature_window must be in (0, 1], got " << feature_window;
+  } else if (map_observations_per_image < 0) {
+    message << "map_observations_per_image must be >= 0, got "
+            << map_observations_per_image;
   } else if (num_map_images < 0 || !(map_noise_px >= 0) ||
              !(map_point_noise >= 0) || !(map_pose_noise_deg >= 0) ||
              !(map_pose_noise >= 0) || !std::isfinite(map_drift_deg) ||

@@ -88,6 +88,10 @@ struct SyntheticRigOptions {
   // points are only as good as its triangulation. 0 map images: none (the
   // default; the map points are then exact unless map_point_noise > 0).
   int num_map_images = 0;
+  // At most this many observations per map image (0: every visible point),
+  // the points that rig images observe first: a COLMAP map image holds a few
+  // thousand of the points in its view.
+  int map_observations_per_image = 0;
   double map_noise_px = 0.5;
   double map_point_noise = 0.0;
   // A map as structure from motion makes it (with num_map_images > 0): the

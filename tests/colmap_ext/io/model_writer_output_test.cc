@@ -156,7 +156,10 @@ void ExpectSummary(const std::string& output) {
   // The timings, which change from run to run, are in a file of their own.
   EXPECT_FALSE(json.contains("timings_s"));
   std::ifstream timings_file(output + "/" + kTimingsFile);
-  EXPECT_EQ(nlohmann::json::parse(timings_file)["timings_s"]["localize"], 1.5);
+  const nlohmann::json timings = nlohmann::json::parse(timings_file);
+  EXPECT_EQ(timings["timings_s"]["localize"], 1.5);
+  EXPECT_EQ(timings["cpu_s"]["localize"], 2.5);
+  EXPECT_EQ(timings["iterations"]["localize"], 7);
 }
 
 class ModelWriterOutput : public ::testing::TestWithParam<std::string> {};
@@ -171,7 +174,7 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
       SummarizeCalibration(scene.dataset, scene.calibration, {});
   summary.method = "1dr";
   summary.diagnostics.push_back("a diagnostic of the caller");
-  summary.timings_s.emplace_back("localize", 1.5);
+  summary.timings.push_back({"localize", 1.5, 2.5, 7});
   summary.seed = 17;
   RigOutputOptions options;
   options.output_type = output_type;

@@ -24,7 +24,7 @@ inline bool WriteSceneOutput(const Scene& scene, const std::string& output,
       SummarizeCalibration(scene.dataset, scene.calibration, {});
   summary.method = "1dr";
   summary.diagnostics.push_back("warning parallel_principal_axes: a warning");
-  summary.timings_s.emplace_back("localize", 1.5);
+  summary.timings.push_back({"localize", 1.5, 2.5, 0});
   RigOutputOptions options;
   if (with_report) options.finish_folder = &WriteReportHtml;
   return WriteRigOutput(output, scene.map, scene.dataset, scene.calibration, {},

@@ -129,9 +129,12 @@ TEST(ModelSelection, ExactWideFisheyeGetsOpenCVFisheye) {
   }
   EXPECT_NEAR(selected.result.tz, 0.1, 1e-8);
   EXPECT_LT(Candidate(selected.choice, "OPENCV_FISHEYE").heldout_rms_px, 1e-6);
-  // A polynomial cannot follow the lens to its corners: dropped or far worse.
+  // A polynomial cannot follow the lens to its corners: dropped, or worse
+  // already on its training error (not held out), or far worse held out.
   const ModelCandidate& opencv = Candidate(selected.choice, "OPENCV");
-  EXPECT_TRUE(!opencv.valid || opencv.heldout_rms_px > 0.5);
+  EXPECT_TRUE(!opencv.valid ||
+              (!opencv.as_good_as_best && !(opencv.heldout_rms_px <= 0.5)));
+  EXPECT_GT(opencv.train_rms_px, 0.5);
 }
 
 TEST(ModelSelection, ExactOpenCVGetsOpenCV) {
@@ -313,6 +316,56 @@ TEST(ModelSelection, MismatchedGroupsFail) {
       data.points_cam, data.groups, &camera, &result, &choice));
   EXPECT_FALSE(result.error_message.empty());
   EXPECT_EQ(camera.ModelName(), "OPENCV_FISHEYE");
+}
+
+// The folds are run only for candidates that can still be as good as the
+// best, and the choice is the one with every candidate held out.
+TEST(ModelSelection, CandidatesWorseOnTrainingErrorAloneAreNotHeldOut) {
+  const int n = 400;
+  // Per row: training errors, and the held-out errors a few percent higher.
+  const auto rows = [&](double level, double wiggle) {
+    std::vector<double> errors(n);
+    for (int e = 0; e < n; ++e) errors[e] = level + wiggle * ((e * 37) % 11);
+    return errors;
+  };
+  const std::vector<std::vector<double>> training = {
+      rows(1.00, 0.01), rows(2.00, 0.01), rows(1.02, 0.01), {}};
+  const std::vector<std::vector<double>> held_out = {
+      rows(1.06, 0.01), rows(2.10, 0.01), rows(1.05, 0.01), {}};
+  std::vector<int> clusters(n);
+  for (int e = 0; e < n; ++e) clusters[e] = e / 4;
+  ModelChoice pruned, full;
+  for (const char* model : {"RADIAL", "OPENCV", "OPENCV_FISHEYE", "PINHOLE"}) {
+    ModelCandidate candidate;
+    candidate.model = model;
+    candidate.num_params = 8;
+    pruned.candidates.push_back(candidate);
+  }
+  full = pruned;
+  std::vector<size_t> held;
+  const std::vector<std::vector<double>> errors = HeldOutErrorsOfContenders(
+      2.0, training, clusters,
+      [&](size_t m) {
+        held.push_back(m);
+        return held_out[m];
+      },
+      &pruned);
+  // By increasing training error; OPENCV (training 2.0 against the best's
+  // held-out 1.06) is left out, the invalid PINHOLE is never considered.
+  EXPECT_EQ(held, (std::vector<size_t>{0, 2}));
+  EXPECT_TRUE(errors[1].empty());
+  EXPECT_TRUE(errors[3].empty());
+  EXPECT_NE(pruned.candidates[1].note.find("training error alone"),
+            std::string::npos);
+  EXPECT_TRUE(std::isnan(pruned.candidates[1].heldout_rms_px));
+  const int chosen_pruned =
+      ChooseByHeldOutError(2.0, errors, clusters, "rows", &pruned);
+  const int chosen_full =
+      ChooseByHeldOutError(2.0, {held_out[0], held_out[1], held_out[2], {}},
+                           clusters, "rows", &full);
+  EXPECT_EQ(chosen_pruned, chosen_full);
+  EXPECT_EQ(pruned.chosen, full.chosen);
+  EXPECT_FALSE(full.candidates[1].as_good_as_best);
 }
 
 }  // namespace

@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# The user's path, timed: `rig_calibrator` with its defaults (camera models
+# `auto`, refine_map, the uncertainty) on a synthetic map that looks like a
+# COLMAP map, and the same data calibrated with the true camera models given
+# by hand, for accuracy. The data: a ring of CAMERAS OPENCV cameras,
+# FRAMESETS framesets, 300 correspondences per image of which 30 % wrong,
+# 10 % of the images missing, a 60-image map whose images hold 3 000 noisy
+# observations each (0.5 px) and whose points are off by 5 mm.
+#
+# Usage: scripts/benchmark_command.sh RESULTS_DIR [FRAMESETS...]
+#   RESULTS_DIR  created if needed; gets command.md (the tables), one folder
+#                per size with the data, both runs' outputs, logs and
+#                /usr/bin/time reports
+#   FRAMESETS    frameset counts (default: 500); two or more also give the
+#                exponent of time and memory in the framesets
+# Environment:
+#   RIG_CALIBRATOR_BUILD_DIR  build folder (default: build/)
+#   BENCHMARK_CAMERAS         cameras on the ring (default 10)
+#   BENCHMARK_THREADS         --RigCalibrator.num_threads (default -1: all)
+set -euo pipefail
+
+log_tag=benchmark_command
+# shellcheck source=common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+
+check_arguments 1 "" "$@"
+results="$1"
+shift
+sizes=("$@")
+[[ ${#sizes[@]} -gt 0 ]] || sizes=(500)
+cameras="${BENCHMARK_CAMERAS:-10}"
+threads="${BENCHMARK_THREADS:--1}"
+[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+[[ -x /usr/bin/time ]] || die "/usr/bin/time is needed (apt-get install time)"
+mkdir -p "$results" || die "cannot create $results"
+results="$(cd "$results" && pwd)"
+
+# run_timed NAME OUT_DIR ARGS...: the calibration, with /usr/bin/time -v.
+run_timed() {
+  local name="$1" out="$2"
+  shift 2
+  rm -rf "$out"
+  /usr/bin/time -v -o "$out.time" "$rig_calibrator" \
+    --RigCalibrator.num_threads "$threads" --output_path "$out" "$@" \
+    >"$out.log" 2>&1 || die "$name failed; see $out.log"
+  "$rig_calibrator" evaluate --reference_path "$data/ground_truth/camchain.yaml" \
+    --calibration_path "$out" --output_path "$out.errors.json" >/dev/null ||
+    die "evaluating $name failed"
+}
+
+for framesets in "${sizes[@]}"; do
+  case_dir="$results/ring${cameras}_${framesets}"
+  data="$case_dir/data"
+  mkdir -p "$case_dir"
+  echo "[$log_tag] === $cameras cameras x $framesets framesets"
+  rm -rf "$data"
+  "$rig_calibrator" synthetic --output_path "$data" --preset ring5 \
+    --ring_num_cameras "$cameras" --num_framesets "$framesets" \
+    --points_per_image 300 --outlier_ratio 0.3 --missing_image_ratio 0.1 \
+    --num_map_images 60 --map_observations_per_image 3000 \
+    --map_noise_px 0.5 --map_point_noise 0.005 >"$case_dir/synthetic.log" ||
+    die "generating the data failed; see $case_dir/synthetic.log"
+  true_models="$(sed -n 's/.*--RigCalibrator.camera_model \([^ ]*\).*/\1/p' \
+    "$case_dir/synthetic.log" | head -n 1)"
+  [[ -n "$true_models" ]] || die "no camera models in $case_dir/synthetic.log"
+  inputs=(--correspondences_path "$data/correspondences.txt"
+          --input_path "$data/sparse")
+  echo "[$log_tag] defaults"
+  run_timed "the defaults" "$case_dir/defaults" "${inputs[@]}"
+  echo "[$log_tag] true models given by hand"
+  run_timed "the true models" "$case_dir/true_models" "${inputs[@]}" \
+    --RigCalibrator.camera_model "$true_models"
+done
+
+/usr/bin/python3 - "$results" "$cameras" "${sizes[@]}" <<'EOF'
+import json, math, os, re, sys
+
+results, cameras, sizes = sys.argv[1], int(sys.argv[2]), [int(s) for s in sys.argv[3:]]
+
+def time_report(path):
+    text = open(path).read()
+    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", text).group(1)
+    seconds = 0.0
+    for part in wall.split(":"):
+        seconds = seconds * 60 + float(part)
+    user = float(re.search(r"User time \(seconds\): (\S+)", text).group(1))
+    system = float(re.search(r"System time \(seconds\): (\S+)", text).group(1))
+    rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
+    return seconds, user + system, rss_kb / 1024.0 ** 2
+
+def worst(errors_path):
+    errors = json.load(open(errors_path))
+    keys = {"rotation_deg": "rot (deg)", "center_error": "centre",
+            "focal_error_percent": "f (%)", "principal_point_error_px": "pp (px)",
+            "mean_projection_diff_px": "proj (px)"}
+    cams = errors.get("cameras", [])
+    return {label: max(c[key] for c in cams) for key, label in keys.items()
+            if cams and key in cams[0]}
+
+out = ["# The calibrate command with its defaults", "",
+       "Measured by `bash scripts/benchmark_command.sh RESULTS " +
+       " ".join(map(str, sizes)) + "` (" + str(os.cpu_count()) +
+       " cores). The defaults: camera models `auto`, refine_map, the "
+       "uncertainty; wall and CPU (user + system) of the whole command, "
+       "reading and writing included, peak resident memory.", ""]
+rows = {}
+for framesets in sizes:
+    case = os.path.join(results, "ring%d_%d" % (cameras, framesets))
+    for run in ("defaults", "true_models"):
+        wall, cpu, rss = time_report(os.path.join(case, run + ".time"))
+        timings = json.load(open(os.path.join(case, run, "timings.json")))
+        rows[(framesets, run)] = (wall, cpu, rss, timings,
+                                  worst(os.path.join(case, run + ".errors.json")))
+stages = []
+for (_, _, _, timings, _) in rows.values():
+    for stage in timings["timings_s"]:
+        if stage not in stages:
+            stages.append(stage)
+out.append("| framesets | run | wall (s) | CPU (s) | CPU/wall | peak (GB) | " +
+           " | ".join(stages) + " |")
+out.append("|---" * (6 + len(stages)) + "|")
+for (framesets, run), (wall, cpu, rss, timings, _) in sorted(rows.items()):
+    cells = []
+    for stage in stages:
+        if stage not in timings["timings_s"]:
+            cells.append("-")
+            continue
+        cell = "%.1f / %.1f" % (timings["timings_s"][stage], timings["cpu_s"][stage])
+        if stage in timings.get("iterations", {}):
+            cell += " (%d it.)" % timings["iterations"][stage]
+        cells.append(cell)
+    out.append("| %d x %d | %s | %.1f | %.1f | %.2f | %.2f | %s |" %
+               (framesets, cameras, run.replace("_", " "), wall, cpu, cpu / wall, rss,
+                " | ".join(cells)))
+out += ["", "Stage cells: wall / CPU seconds (solver iterations).", "",
+        "Accuracy against the ground truth, the worst camera:", ""]
+labels = list(next(iter(rows.values()))[4].keys())
+out.append("| framesets | run | " + " | ".join(labels) + " |")
+out.append("|---" * (2 + len(labels)) + "|")
+for (framesets, run), (_, _, _, _, errors) in sorted(rows.items()):
+    out.append("| %d x %d | %s | %s |" % (framesets, cameras, run.replace("_", " "),
+               " | ".join("%.4g" % errors[label] for label in labels)))
+if len(sizes) >= 2:
+    a, b = min(sizes), max(sizes)
+    out += ["", "Exponent in the framesets, %d to %d (defaults): " % (a, b)]
+    for index, name in ((0, "wall"), (1, "CPU"), (2, "peak memory")):
+        ratio = rows[(b, "defaults")][index] / rows[(a, "defaults")][index]
+        out[-1] += "%s %.2f; " % (name, math.log(ratio) / math.log(b / a))
+open(os.path.join(results, "command.md"), "w").write("\n".join(out) + "\n")
+print("\n".join(out))
+EOF
