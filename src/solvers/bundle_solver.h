@@ -22,10 +22,11 @@
 // Levenberg-Marquardt from the current values, stopping when a step changes
 // F by at most function_tolerance * F, when |delta| <= parameter_tolerance *
 // (|x| + parameter_tolerance), when max |gradient| <= gradient_tolerance, or
-// after max_num_iterations steps (accepted or not). The backends share these
-// rules (Ceres' own) but not their paths: Ceres scales the Jacobian's columns
-// (jacobi_scaling) and discards the step that meets the function tolerance,
-// which the own solver keeps.
+// after max_num_iterations steps (accepted or not). The own solver follows
+// Ceres' Levenberg-Marquardt step for step (the same damping, trust-region
+// updates and robust-loss correction); they part at the end: Ceres discards
+// the step that meets the function tolerance, the own solver keeps it
+// (docs/solver_comparison.md).
 #pragma once
 
 #include <ceres/cost_function.h>
