@@ -117,6 +117,11 @@ void AddRigCalibratorOptions(po::options_description* description,
             "-1: all cores (the result does not depend on the count)");
   AddOption(description, "RigCalibrator.seed", &o->seed,
             "random seed (results are deterministic for a seed)");
+  AddOption(description, "RigCalibrator.bundle_solver", &o->bundle_solver,
+            "solver of the bundle adjustments: own (the project's "
+            "Levenberg-Marquardt) or ceres (Ceres', the reference it is "
+            "compared with: the same minimum, slower, and not bit-identical "
+            "across thread counts)");
 }
 
 void AddLocalizationOptions(po::options_description* description,
@@ -212,6 +217,14 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
         options->method;
     return false;
   }
+  BundleSolverBackend bundle_solver;
+  if (!BundleSolverBackendFromName(options->bundle_solver, &bundle_solver)) {
+    *error = "--RigCalibrator.bundle_solver must be own or ceres, not " +
+             options->bundle_solver;
+    return false;
+  }
+  pipeline->radial_bundle_adjustment.bundle_solver = bundle_solver;
+  pipeline->final_bundle_adjustment.bundle_solver = bundle_solver;
   pipeline->num_threads = options->num_threads;
   pipeline->seed = static_cast<unsigned int>(options->seed);
   pipeline->initial_pose.radial.max_error_px = options->radial_max_error_px;

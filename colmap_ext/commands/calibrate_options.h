@@ -56,6 +56,8 @@ struct CalibrateOptions {
   int min_num_inliers = 15;
   int num_threads = -1;
   int seed = 0;
+  // The bundle adjustments' solver backend (bundle_solver.h): own or ceres.
+  std::string bundle_solver = "own";
 
   std::string localization_mode = "direct";
   std::string vocab_tree_path;

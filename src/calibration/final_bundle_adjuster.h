@@ -18,12 +18,13 @@
 // points by their 3 x 3 blocks and factorizes the reduced system over the rig
 // poses, map poses and cameras (a camera's cam_from_rig and intrinsics one
 // block) with a sparse Cholesky; it uses every thread and its result does
-// not depend on their count.
+// not depend on their count. Or Ceres', to compare with (bundle_solver).
 #pragma once
 
 #include <string>
 
 #include "src/calibration/rig_dataset.h"
+#include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {
 
@@ -96,9 +97,13 @@ struct FinalBundleAdjustmentOptions {
   // Prune-and-resolve rounds after the first solve; stops early when a round
   // prunes nothing. 0: no pruning.
   int num_pruning_rounds = 2;
-  // Solver threads (-1: all cores); the result does not depend on them.
+  // Solver threads (-1: all cores); the own solver's result does not depend
+  // on them.
   int num_threads = -1;
   bool print_progress = false;  // per-iteration progress on stdout
+  // The solver's backend (bundle_solver.h): the own one, or Ceres' to
+  // compare with.
+  BundleSolverBackend bundle_solver = BundleSolverBackend::kOwn;
 };
 
 struct FinalBundleAdjustmentSummary {

@@ -58,8 +58,9 @@ struct PipelineOptions {
 
   // Threads of every stage. The results do not depend on the count: the
   // stages split their work by image or camera, and the bundle adjustments'
-  // solver (bundle_levenberg_marquardt.h) adds its parts in a fixed order,
-  // so the calibration is bit-identical for a seed, whatever num_threads.
+  // own solver (bundle_levenberg_marquardt.h; not the ceres backend) adds its
+  // parts in a fixed order, so the calibration is bit-identical for a seed,
+  // whatever num_threads.
   int num_threads = -1;
   unsigned int seed = 0;
   bool print_progress = true;

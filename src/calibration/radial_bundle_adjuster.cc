@@ -13,7 +13,7 @@
 
 #include "src/calibration/principal_axes.h"
 #include "src/geometry/radial_rig_cost_function.h"
-#include "src/solvers/bundle_levenberg_marquardt.h"
+#include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {
 namespace {
@@ -94,8 +94,8 @@ std::vector<Observation> KeepDeterminedFramesets(
   return kept;
 }
 
-// One Levenberg-Marquardt solve over the observations
-// (bundle_levenberg_marquardt.h, no points: every rig pose is a block row of
+// One Levenberg-Marquardt solve over the observations (bundle_solver.h,
+// options.bundle_solver's backend; no points: every rig pose is a block row of
 // the reduced system, which the sparse Cholesky's ordering eliminates
 // first, as no residual links two). Gauge: the reference camera's pose is
 // constant, every camera's tz is held, and so is the t_z of one rig pose
@@ -117,12 +117,15 @@ BundleLevenbergMarquardtSummary Solve(
   }
   BundleLevenbergMarquardtOptions solver_options;
   solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
   // Noisy problems stop on the relative cost change (1e-6); this lets exact
   // ones converge to the last digits of map-unit poses.
   solver_options.parameter_tolerance = 1e-10;
   solver_options.num_threads = options.num_threads;
   solver_options.print_progress = options.print_progress;
-  BundleLevenbergMarquardt solver(solver_options);
+  const std::unique_ptr<BundleSolver> solver_pointer =
+      MakeBundleSolver(options.bundle_solver, solver_options);
+  BundleSolver& solver = *solver_pointer;
   // The cost's tangent Jacobians (RadialRigCostFunction) are for these
   // manifolds; the gauge pose's residuals (t_z held) take the ambient path.
   const RigPoseManifold rig_pose_manifold;

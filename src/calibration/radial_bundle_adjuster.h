@@ -15,6 +15,7 @@
 #include <string>
 
 #include "src/calibration/rig_dataset.h"
+#include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {
 
@@ -39,6 +40,12 @@ struct RadialBundleAdjustmentOptions {
   int max_correspondences_per_image = 100;
   int num_threads = -1;
   bool print_progress = false;  // per-iteration progress on stdout
+  // Each solve stops when a step changes the cost by at most this share of
+  // it (Ceres' default), or on the parameter tolerance (1e-10).
+  double function_tolerance = 1e-6;
+  // The solver's backend (bundle_solver.h): the own one, or Ceres' to
+  // compare with.
+  BundleSolverBackend bundle_solver = BundleSolverBackend::kOwn;
 };
 
 struct RadialBundleAdjustmentSummary {
@@ -65,10 +72,10 @@ struct RadialBundleAdjustmentSummary {
 // correspondences are those selected by calibration->images[k].inlier_mask
 // of images of calibrated cameras whose frameset has a rig pose; the
 // observed points are centered on calibration->cameras[i]'s principal point.
-// The solver (bundle_levenberg_marquardt.h) runs on num_threads threads, with
-// the same result on any count. Correspondences with a radial error above
-// max_radial_error_px after a first solve, and mostly-outlier images, are
-// dropped for a second one.
+// The solver (bundle_solver.h, options.bundle_solver) runs on num_threads
+// threads; the own backend's result is the same on any count.
+// Correspondences with a radial error above max_radial_error_px after a
+// first solve, and mostly-outlier images, are dropped for a second one.
 // Returns false, with calibration unchanged and the reason in
 // summary->message and the log, on inconsistent input, if the reference
 // camera has no correspondences, or if the solver fails. summary may be

@@ -16,7 +16,7 @@
 
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/rig_dataset.h"
-#include "src/solvers/bundle_levenberg_marquardt.h"
+#include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {
 
@@ -182,7 +182,7 @@ class RigAdjustment {
   // 500 framesets x 10 cameras); later solves deactivate the observations
   // that left and hold the points no longer refined. Last: destroyed first,
   // it points into the members above.
-  std::unique_ptr<BundleLevenbergMarquardt> solver_;
+  std::unique_ptr<BundleSolver> solver_;
 };
 
 }  // namespace rig_calibrator

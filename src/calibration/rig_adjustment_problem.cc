@@ -1,8 +1,8 @@
 // The problem of the final bundle adjustment: one RigReprojectionCost per
 // observation (a map image's: its cam_from_world as the "rig" pose, a
 // constant identity cam_from_rig), the blocks that are refined, held or
-// partly held, and its solve by BundleLevenbergMarquardt with the refined
-// points eliminated.
+// partly held, and its solve by the bundle solver (bundle_solver.h, the
+// options' backend) with the refined points eliminated.
 #include <glog/logging.h>
 
 #include "src/calibration/rig_adjustment.h"
@@ -24,7 +24,7 @@ bool RigAdjustment::Solve(double function_tolerance,
     solver_options.parameter_tolerance = 1e-12;
     solver_options.num_threads = options_.num_threads;
     solver_options.print_progress = options_.print_progress;
-    solver_ = std::make_unique<BundleLevenbergMarquardt>(solver_options);
+    solver_ = MakeBundleSolver(options_.bundle_solver, solver_options);
     const std::vector<MapObservationRef> map_observations =
         MapObservationsInProblem();
     solver_->Reserve(observations_.size() + map_observations.size(),

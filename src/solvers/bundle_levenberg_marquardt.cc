@@ -13,7 +13,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
-#include <sstream>
 #include <thread>
 #include <unordered_map>
 
@@ -133,19 +132,6 @@ void PrintIteration(int iteration, double cost, double cost_change,
 }
 
 }  // namespace
-
-std::string BundleLevenbergMarquardtSummary::BriefReport() const {
-  std::ostringstream report;
-  report << "Bundle Levenberg-Marquardt: Iterations: "
-         << num_successful_steps + num_unsuccessful_steps
-         << ", Initial cost: " << initial_cost << ", Final cost: " << final_cost
-         << ", Termination: "
-         << (termination == Termination::kConvergence     ? "CONVERGENCE"
-             : termination == Termination::kNoConvergence ? "NO_CONVERGENCE"
-                                                          : "FAILURE")
-         << " (" << message << ")";
-  return report.str();
-}
 
 struct BundleLevenbergMarquardt::Impl {
   struct Block {

@@ -50,91 +50,40 @@
 // whose threads add in the order they finish.
 #pragma once
 
-#include <ceres/cost_function.h>
-#include <ceres/loss_function.h>
-#include <ceres/manifold.h>
-
 #include <memory>
-#include <string>
 #include <vector>
 
 #include "src/geometry/tangent_jacobian_cost.h"
+#include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {
 
-struct BundleLevenbergMarquardtOptions {
-  int max_num_iterations = 100;
-  double function_tolerance = 1e-6;
-  double parameter_tolerance = 1e-8;
-  double gradient_tolerance = 1e-10;
-  double initial_trust_region_radius = 1e4;
-  int num_threads = -1;  // -1: all cores; the result does not depend on it
-  // One line per iteration on stdout (Ceres' columns; |gradient| is nan on
-  // the line of an accepted step that ends the solve: not evaluated there).
-  bool print_progress = false;
-};
-
-struct BundleLevenbergMarquardtSummary {
-  enum class Termination { kConvergence, kNoConvergence, kFailure };
-  Termination termination = Termination::kFailure;
-  std::string message;
-  int num_successful_steps = 0, num_unsuccessful_steps = 0;
-  double initial_cost = 0, final_cost = 0;  // F
-  int num_residual_blocks = 0, num_points = 0, reduced_system_size = 0;
-  // Wall time of Solve, of which building the structure (batches, the
-  // reduced system's pattern and its symbolic factorization), evaluating
-  // residuals and Jacobians, forming the reduced system and factorizing it
-  // (seconds).
-  double seconds = 0, structure_seconds = 0, evaluation_seconds = 0,
-         schur_seconds = 0, factorization_seconds = 0;
-
-  bool IsSolutionUsable() const { return termination != Termination::kFailure; }
-  // One line: iterations, costs, termination (CONVERGENCE, NO_CONVERGENCE or
-  // FAILURE) and the message.
-  std::string BriefReport() const;
-};
-
-class BundleLevenbergMarquardt {
+// The kOwn backend of bundle_solver.h (its contract there; what follows is
+// this backend's).
+class BundleLevenbergMarquardt final : public BundleSolver {
  public:
   explicit BundleLevenbergMarquardt(
       const BundleLevenbergMarquardtOptions& options);
-  ~BundleLevenbergMarquardt();
+  ~BundleLevenbergMarquardt() override;
 
-  // A camera-side parameter block of `size` values at `values`, refined on
-  // `manifold` (null: Euclidean) as part of group `group` (>= 0; groups are
-  // numbered from 0 without gaps, and a group's blocks are its columns in the
-  // order they are added). Not owned; they outlive Solve.
   void AddParameterBlock(double* values, int size,
-                         const ceres::Manifold* manifold, int group);
-  // Room for this many residual blocks and points (saves regrowing the
-  // lists at 10^6 residuals).
-  void Reserve(size_t num_residual_blocks, size_t num_points);
-  // A point (3 values, Euclidean), eliminated in the reduced system.
-  void AddPoint(double* values);
-  // A residual block of 2 rows: `cost` over `parameters` (the pointers its
-  // Evaluate takes, in its order; the parameter blocks added before). A
-  // TangentJacobianCost is evaluated by EvaluateTangent where it can be. A
-  // pointer that was added as a parameter block or a point is refined, any
-  // other is held constant. `loss` null: least squares. Neither is owned.
-  // Returns its index, from 0 in the order of addition.
+                         const ceres::Manifold* manifold, int group) override;
+  void Reserve(size_t num_residual_blocks, size_t num_points) override;
+  void AddPoint(double* values) override;
+  // A TangentJacobianCost is evaluated by EvaluateTangent where it can be.
   size_t AddResidualBlock(const ceres::CostFunction* cost,
                           const ceres::LossFunction* loss,
-                          const std::vector<double*>& parameters);
+                          const std::vector<double*>& parameters) override;
 
-  // Changes between solves that keep the structure (the reduced system's
-  // pattern and its symbolic factorization, built at the first Solve after
-  // an addition), for solves over a shrinking problem, e.g. after outlier
-  // pruning: an inactive residual block counts as removed (zero residual and
-  // Jacobian); a held point (added by AddPoint) is a constant of its
-  // residuals, as if it had not been added; the function tolerance of the
-  // next solves.
-  void SetResidualBlockActive(size_t index, bool active);
-  void SetPointHeld(const double* values, bool held);
-  void SetFunctionTolerance(double tolerance);
+  // These keep the structure (the reduced system's pattern and its symbolic
+  // factorization, built at the first Solve after an addition): an inactive
+  // residual block has a zero residual and Jacobian.
+  void SetResidualBlockActive(size_t index, bool active) override;
+  void SetPointHeld(const double* values, bool held) override;
+  void SetFunctionTolerance(double tolerance) override;
 
-  // Minimizes F from the current values, which it updates (the last accepted
-  // estimate, also when the solve fails midway).
-  void Solve(BundleLevenbergMarquardtSummary* summary);
+  // After a failure midway, the values are the last accepted estimate.
+  void Solve(BundleLevenbergMarquardtSummary* summary) override;
 
  private:
   struct Impl;

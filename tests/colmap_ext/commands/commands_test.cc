@@ -90,6 +90,22 @@ TEST_F(CommandsTest, SyntheticCalibrateEvaluate) {
   }
 }
 
+// The bundle adjustments on Ceres' solver (bundle_solver.h): a calibration
+// as accurate as the own solver's.
+TEST_F(CommandsTest, CeresBundleSolverCalibratesToo) {
+  const std::string output = temp_.File("calibration");
+  std::vector<std::string> arguments = CalibrateArguments(output);
+  arguments.insert(arguments.end(), {"--RigCalibrator.bundle_solver", "ceres"});
+  ASSERT_EQ(RunCommand(&RunCalibrate, arguments), EXIT_SUCCESS);
+  const nlohmann::json cameras = EvaluatedCameras(output);
+  ASSERT_EQ(cameras.size(), 5u);
+  for (const nlohmann::json& camera : cameras) {
+    EXPECT_LT(camera["rotation_deg"].get<double>(), 0.1);
+    EXPECT_LT(camera["center_error"].get<double>(), 0.005);
+    EXPECT_LT(camera["focal_error_percent"].get<double>(), 0.3);
+  }
+}
+
 TEST_F(CommandsTest, RerunFromWrittenCorrespondencesReproducesTheResult) {
   const std::string first = temp_.File("first");
   ASSERT_EQ(RunCommand(&RunCalibrate, CalibrateArguments(first)), EXIT_SUCCESS);
@@ -136,6 +152,15 @@ TEST_F(CommandsTest, BadInputFailsWithoutOutput) {
                                  "not magic"),
             std::string::npos)
       << method_messages;
+  std::vector<std::string> bad_solver = arguments;
+  bad_solver.insert(bad_solver.end(), {"--RigCalibrator.bundle_solver", "g2o"});
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunCommand(&RunCalibrate, bad_solver), EXIT_FAILURE);
+  const std::string solver_messages = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(solver_messages.find(
+                "--RigCalibrator.bundle_solver must be own or ceres, not g2o"),
+            std::string::npos)
+      << solver_messages;
   std::vector<std::string> bad_model = arguments;
   bad_model[5] = "NOT_A_MODEL";
   EXPECT_EQ(RunCommand(&RunCalibrate, bad_model), EXIT_FAILURE);
@@ -333,8 +358,8 @@ TEST(Benchmark, MethodsOptionSelectsTheMethods) {
   testing::ScopedTempDir temp;
   const std::string table = temp.File("table.md");
   const std::vector<std::string> small = {
-      "--num_sequences", "2", "--recording_framesets", "16",
-      "--framesets_per_sequence", "6", "--output_path", table};
+      "--num_sequences",          "2", "--recording_framesets", "16",
+      "--framesets_per_sequence", "6", "--output_path",         table};
   std::vector<std::string> arguments = small;
   arguments.insert(arguments.end(), {"--methods", "known_ra,1dr"});
   ::testing::internal::CaptureStdout();
