@@ -24,7 +24,7 @@
 
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/io/database_reader.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

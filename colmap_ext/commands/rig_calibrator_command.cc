@@ -9,7 +9,7 @@
 
 #include "colmap_ext/commands/commands.h"
 #include "colmap_ext/commands/guarded_run.h"
-#include "colmap_ext/commands/render_command.h"
+#include "colmap_ext/lab_commands/render_command.h"
 
 namespace rig_calibrator {
 namespace {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "colmap_ext/io/rig_description.h"
-#include "src/evaluation/calibration_uncertainty.h"
+#include "src/calibration/calibration_uncertainty.h"
 
 namespace rig_calibrator {
 

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "src/calibration/pipeline_report.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

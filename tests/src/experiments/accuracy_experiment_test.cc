@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include "colmap_ext/report/svg_plot.h"
 #include "src/experiments/robustness_experiment.h"
-#include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

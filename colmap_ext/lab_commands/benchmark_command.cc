@@ -16,10 +16,10 @@
 #include "colmap_ext/commands/command_options.h"
 #include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/report/svg_plot.h"
 #include "src/experiments/accuracy_experiment.h"
 #include "src/experiments/robustness_experiment.h"
 #include "src/experiments/short_sequence_experiment.h"
-#include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {
