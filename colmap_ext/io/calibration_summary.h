@@ -102,7 +102,7 @@ struct CalibrationSummary {
 // sets method, seed, units, map_looks_metric, diagnostics and timings. Camera
 // names come from the dataset, image prefixes from `image_prefixes` (one per
 // camera, or empty for name + "/"). cam_from_rig is relative to the reference
-// camera. Requires ValidateCalibration (src/calibration/rig_dataset.h).
+// camera. Requires ValidateCalibration (src/rig/rig_dataset.h).
 CalibrationSummary SummarizeCalibration(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);
