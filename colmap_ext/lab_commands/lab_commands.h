@@ -9,8 +9,8 @@
 
 namespace rig_calibrator {
 
-// Runs `PROGRAM <command> [options]` over the sub-commands below and RunRender
-// (render_command.h) (colmap_ext/commands/command_table.h).
+// Runs `PROGRAM <command> [options]` (colmap_ext/commands/command_table.h)
+// over the sub-commands below and RunRender (render_command.h).
 int RunRigCalibratorLab(const std::string& program, int argc, char** argv);
 
 // Writes a synthetic rig dataset (2D-3D correspondences) with its ground truth.
