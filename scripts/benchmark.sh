@@ -20,14 +20,14 @@ if [[ "${1:-}" == "--quick" ]]; then
 fi
 [[ $# -le 1 ]] || die "usage: scripts/benchmark.sh [--quick] [RESULTS_DIR]"
 results="${1:-$repo/benchmark_results}"
-[[ -x "$rig_calibrator" ]] ||
-  die "$rig_calibrator not found: build first (bash scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+[[ -x "$rig_calibrator_lab" ]] ||
+  die "$rig_calibrator_lab not found: build first (bash scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create the results folder $results"
 
 start=$SECONDS
-echo "== Accuracy and robustness (rig_calibrator benchmark) into $results"
-"$rig_calibrator" benchmark --experiment all --quick "$quick" \
-  --output_path "$results" || die "rig_calibrator benchmark failed"
+echo "== Accuracy and robustness (rig_calibrator_lab benchmark) into $results"
+"$rig_calibrator_lab" benchmark --experiment all --quick "$quick" \
+  --output_path "$results" || die "rig_calibrator_lab benchmark failed"
 echo "== Accuracy and robustness took $((SECONDS - start)) s"
 
 runtime_script="$repo/scripts/benchmark_runtime.sh"

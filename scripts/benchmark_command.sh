@@ -30,7 +30,7 @@ sizes=("$@")
 [[ ${#sizes[@]} -gt 0 ]] || sizes=(500)
 cameras="${BENCHMARK_CAMERAS:-10}"
 threads="${BENCHMARK_THREADS:--1}"
-[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+[[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 [[ -x /usr/bin/time ]] || die "/usr/bin/time is needed (apt-get install time)"
 mkdir -p "$results" || die "cannot create $results"
 results="$(cd "$results" && pwd)"
@@ -54,7 +54,7 @@ for framesets in "${sizes[@]}"; do
   mkdir -p "$case_dir"
   echo "[$log_tag] === $cameras cameras x $framesets framesets"
   rm -rf "$data"
-  "$rig_calibrator" synthetic --output_path "$data" --preset ring5 \
+  "$rig_calibrator_lab" synthetic --output_path "$data" --preset ring5 \
     --ring_num_cameras "$cameras" --num_framesets "$framesets" \
     --points_per_image 300 --outlier_ratio 0.3 --missing_image_ratio 0.1 \
     --num_map_images 60 --map_observations_per_image 3000 \

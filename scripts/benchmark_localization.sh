@@ -14,7 +14,8 @@
 #                (one row per localization run), calibration_{before,after}/
 #                and evaluate_{before,after}.txt, localization_log.txt
 # Environment:
-#   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator (default: build/)
+#   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator and
+#                             rig_calibrator_lab (default: build/)
 #   LOCALIZATION_DEMO_DIR     an output of scripts/demo.sh to reuse (map/sparse/0,
 #                             rig/database.db, dataset/); default: RESULTS_DIR/demo,
 #                             made by scripts/demo.sh the first time (~4 min idle)
@@ -32,7 +33,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 check_arguments 1 1 "$@"
 results="$1"
-[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+[[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] ||
+  die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create $results"
 results="$(cd "$results" && pwd)"
 csv="$results/localization.csv"
@@ -58,7 +60,7 @@ after_flags=(--Localization.guided 1 --Localization.guided_max_ratio 0.6)
 bench() {
   local label="$1" database="$2" model="$3"
   shift 3
-  "$rig_calibrator" benchmark_localization --database_path "$database" \
+  "$rig_calibrator_lab" benchmark_localization --database_path "$database" \
     --input_path "$model" --label "$label" --csv_path "$csv" "$@" 2>> "$log" |
     tee -a "$log" || die "benchmark_localization $label failed (log: $log)"
 }
@@ -89,7 +91,7 @@ fi
 # Index build, memory and throughput on synthetic maps.
 for points in $scale_points; do
   map="$work/map_$points"
-  "$rig_calibrator" benchmark_localization --write_synthetic_map "$map" \
+  "$rig_calibrator_lab" benchmark_localization --write_synthetic_map "$map" \
     --map_points "$points" --rig_images "$scale_rig_images" --rig_features 4096 2>> "$log" |
     tee -a "$log" || die "writing the synthetic map of $points points failed (log: $log)"
   bench "synthetic${points}_before" "$map/database.db" "$map/sparse" "${before_flags[@]}"

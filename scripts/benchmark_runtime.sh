@@ -2,12 +2,12 @@
 # Runtime benchmark: time and peak memory of the calibration core on
 # synthetic rigs (10-500 framesets x 5 and 10 cameras, ~300 correspondences
 # per image, map points with 5 mm error) and of the localization against a
-# 300-image map (`rig_calibrator benchmark_runtime`), optionally before and
+# 300-image map (`rig_calibrator_lab benchmark_runtime`), optionally before and
 # after (another build's runs of the same data, in the same run), and
 # optionally the end-to-end time of the rendered demo (scripts/demo.sh)
 # split into COLMAP's steps and ours, and optionally our final bundle
 # adjustment side by side with COLMAP 3.8's rig_bundle_adjuster on the same
-# problem (`rig_calibrator benchmark_colmap_rig_ba`).
+# problem (`rig_calibrator_lab benchmark_colmap_rig_ba`).
 #
 # Usage: scripts/benchmark_runtime.sh RESULTS_DIR [benchmark_runtime options...]
 #   RESULTS_DIR  created if needed; gets runtime.md, runtime_calibration.csv,
@@ -17,14 +17,15 @@
 #                runtime_demo_log.txt, with the COLMAP comparison
 #                colmap_rig_ba.md, colmap_rig_ba.csv and colmap_rig_ba_log.txt
 #                (other files are left alone)
-#   options      passed to `rig_calibrator benchmark_runtime`, e.g.
+#   options      passed to `rig_calibrator_lab benchmark_runtime`, e.g.
 #                --framesets 10,50 --cameras 5 --localization 0
 # Environment:
-#   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator (default: build/)
+#   RIG_CALIBRATOR_BUILD_DIR  build folder with rig_calibrator_lab (default: build/)
 #   RUNTIME_DEMO=1            also time the rendered demo (about 3-4 minutes on
 #                             2 idle cores; DEMO_* variables apply)
-#   RUNTIME_BASELINE=EXE      another rig_calibrator build (e.g. of the
-#                             previous commit): every calibration run is made
+#   RUNTIME_BASELINE=EXE      another build's rig_calibrator_lab (e.g. of the
+#                             previous commit; before the lab, its
+#                             rig_calibrator): every calibration run is made
 #                             with it first, then with this build, and
 #                             runtime.md gets the before/after table
 #   RUNTIME_COLMAP_RIG_BA=1   also compare the final bundle adjustment with
@@ -48,7 +49,7 @@ check_arguments 1 "" "$@"
 results="$1"
 shift
 
-[[ -x "$rig_calibrator" ]] || die "no $rig_calibrator; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
+[[ -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create $results"
 results="$(cd "$results" && pwd)"
 
@@ -56,30 +57,30 @@ options=("$@")
 if [[ "${BENCHMARK_QUICK:-0}" == 1 && $# -eq 0 ]]; then
   options=(--framesets 10,20 --cameras 5 --map_images 30 --rig_features 1000
            --rig_images 4 --retrieval_images 1 --repeats 2)
-  RUNTIME_BASELINE="${RUNTIME_BASELINE:-$rig_calibrator}"
+  RUNTIME_BASELINE="${RUNTIME_BASELINE:-$rig_calibrator_lab}"
   RUNTIME_COLMAP_RIG_BA="${RUNTIME_COLMAP_RIG_BA:-1}"
   RUNTIME_COLMAP_RIG_BA_OPTIONS="${RUNTIME_COLMAP_RIG_BA_OPTIONS:---quick 1}"
 fi
 if [[ -n "${RUNTIME_BASELINE:-}" ]]; then
-  [[ -x "$RUNTIME_BASELINE" ]] || die "RUNTIME_BASELINE=$RUNTIME_BASELINE is not an executable rig_calibrator"
+  [[ -x "$RUNTIME_BASELINE" ]] || die "RUNTIME_BASELINE=$RUNTIME_BASELINE is not an executable rig_calibrator_lab"
   options+=(--baseline_executable "$RUNTIME_BASELINE")
 fi
 
 echo "[benchmark_runtime] $(nproc) cores, $(uptime)"
 status=0
-"$rig_calibrator" benchmark_runtime --output_path "$results" "${options[@]}" 2>&1 |
+"$rig_calibrator_lab" benchmark_runtime --output_path "$results" "${options[@]}" 2>&1 |
   tee "$results/runtime_log.txt" || status=${PIPESTATUS[0]}
-[[ "$status" -eq 0 ]] || die "rig_calibrator benchmark_runtime failed with status $status (log: $results/runtime_log.txt)"
+[[ "$status" -eq 0 ]] || die "rig_calibrator_lab benchmark_runtime failed with status $status (log: $results/runtime_log.txt)"
 
 if [[ "${RUNTIME_COLMAP_RIG_BA:-0}" == 1 ]]; then
   # Word-split on purpose: a list of options.
   # shellcheck disable=SC2206
   colmap_ba_options=(${RUNTIME_COLMAP_RIG_BA_OPTIONS:-})
   echo "[benchmark_runtime] final bundle adjustment vs COLMAP's rig_bundle_adjuster ..."
-  "$rig_calibrator" benchmark_colmap_rig_ba --output_path "$results" \
+  "$rig_calibrator_lab" benchmark_colmap_rig_ba --output_path "$results" \
     "${colmap_ba_options[@]}" 2>&1 | tee "$results/colmap_rig_ba_log.txt" ||
     status=${PIPESTATUS[0]}
-  [[ "$status" -eq 0 ]] || die "rig_calibrator benchmark_colmap_rig_ba failed with status $status (log: $results/colmap_rig_ba_log.txt)"
+  [[ "$status" -eq 0 ]] || die "rig_calibrator_lab benchmark_colmap_rig_ba failed with status $status (log: $results/colmap_rig_ba_log.txt)"
 else
   echo "[benchmark_runtime] COLMAP rig_bundle_adjuster comparison skipped (RUNTIME_COLMAP_RIG_BA=1 runs it)"
 fi

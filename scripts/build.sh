@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets up the dependencies (scripts/setup_deps.sh) and builds rig_calibrator into
 # build/ (or $RIG_CALIBRATOR_BUILD_DIR). The executables are build/colmap
-# (COLMAP 3.8's command line plus `colmap rig_calibrator`) and
-# build/rig_calibrator (the same rig_calibrator commands on their own).
+# (COLMAP 3.8's command line plus `colmap rig_calibrator`),
+# build/rig_calibrator (the same rig_calibrator commands on their own) and
+# build/rig_calibrator_lab (the lab: synthetic data, rendering, benchmarks).
 set -euo pipefail
 
 log_tag=build
@@ -24,4 +25,4 @@ cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release \
   || { echo "[build] ERROR: configuring failed (run cmake in $build to see why)" >&2; exit 1; }
 cmake --build "$build" -j"$jobs" \
   || { echo "[build] ERROR: compiling failed (see the messages above)" >&2; exit 1; }
-echo "[build] done: $build/colmap, $build/rig_calibrator"
+echo "[build] done: $build/colmap, $build/rig_calibrator, $build/rig_calibrator_lab"

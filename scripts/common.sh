@@ -1,9 +1,11 @@
 # Sourced by the scripts, after `set -euo pipefail` and with `log_tag` set to
 # the script's name (the prefix of its messages): the repository, the build
-# folder and the rig_calibrator binary in it, and the helpers below.
+# folder, the rig_calibrator binary in it and the lab's (rig_calibrator_lab:
+# synthetic data, rendering, benchmarks), and the helpers below.
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
 rig_calibrator="$build/rig_calibrator"
+rig_calibrator_lab="$build/rig_calibrator_lab"
 
 # Prints "[log_tag] ERROR: message" and exits 1.
 die() { echo "[$log_tag] ERROR: $*" >&2; exit 1; }

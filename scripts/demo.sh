@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The end-to-end demo on rendered images with exact ground truth:
-#   1. builds rig_calibrator and the extended colmap (scripts/build.sh),
+#   1. builds rig_calibrator, the extended colmap and the lab
+#      (scripts/build.sh),
 #   2. renders a scene seen by a calibrated pinhole camera (the mapping
-#      sequence) and by a rig (the calibration sequence),
+#      sequence) and by a rig (the calibration sequence; rig_calibrator_lab
+#      render),
 #   3. builds a metric COLMAP map from the mapping sequence (the build's
 #      colmap, COLMAP 3.8's commands; aligned to the true camera positions),
 #   4. calibrates the rig against the map (colmap feature_extractor, then
@@ -56,9 +58,11 @@ if [[ "${DEMO_SKIP_BUILD:-0}" != 1 ]]; then
 fi
 # shellcheck source=find_colmap.sh
 source "$repo/scripts/find_colmap.sh"
+[[ -x "$rig_calibrator_lab" ]] ||
+  die "no $rig_calibrator_lab: build it (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 
 dataset="$out/dataset"
-run_step "render ($preset, $scene)" "$colmap_extended" rig_calibrator render \
+run_step "render ($preset, $scene)" "$rig_calibrator_lab" render \
   --preset "$preset" --scene "$scene" --seed "$seed" \
   --num_map_images "$num_map_images" --num_framesets "$num_framesets" \
   --output_path "$dataset"

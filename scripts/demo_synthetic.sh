@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A quick demo without images: sets up and builds, writes a synthetic 5-camera
 # ring (2D-3D correspondences with noise, outliers and missing images, exact
-# ground truth), calibrates it with rig_calibrator and evaluates the result.
+# ground truth; rig_calibrator_lab synthetic), calibrates it with rig_calibrator
+# and evaluates the result.
 #   bash scripts/demo_synthetic.sh [OUTPUT_DIR] [PRESET]
 # PRESET: ring5 (default), fisheye_helmet5, car_surround4, stereo_pair.
 set -euo pipefail
@@ -17,7 +18,7 @@ mkdir -p "$out"
 
 echo "== Synthetic dataset ($preset) in $out/data"
 log="$(mktemp)"
-"$rig_calibrator" synthetic --preset "$preset" --output_path "$out/data" \
+"$rig_calibrator_lab" synthetic --preset "$preset" --output_path "$out/data" \
   --overwrite 1 | tee "$log"
 models="$(grep -o 'camera_model [^ ]*' "$log" | cut -d' ' -f2)"
 rm -f "$log"

@@ -2,7 +2,8 @@
 // rig bundle adjustment problem solved by COLMAP's command (a child process
 // of the extended colmap executable) and by this project's final bundle
 // adjustment (AdjustRig, in process), from the same start, to the same
-// convergence criterion, in one run (`rig_calibrator benchmark_colmap_rig_ba`).
+// convergence criterion, in one run
+// (`rig_calibrator_lab benchmark_colmap_rig_ba`).
 //
 // The start: a synthetic ring rig (runtime benchmark's data) calibrated by
 // the 1dr pipeline up to the input of its final bundle adjustment (single-

@@ -1,4 +1,4 @@
-// The localization benchmark on a real COLMAP map (`rig_calibrator
+// The localization benchmark on a real COLMAP map (`rig_calibrator_lab
 // benchmark_localization`, scripts/benchmark_localization.sh): MapLocalizer
 // with given options on the rig images of a database (features extracted),
 // timed (wall and CPU), with what it found: correspondences, the features

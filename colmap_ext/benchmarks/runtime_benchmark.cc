@@ -11,7 +11,7 @@
 #include <set>
 #include <sstream>
 
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

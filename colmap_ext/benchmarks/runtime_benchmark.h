@@ -1,4 +1,4 @@
-// Results of the runtime benchmark (`rig_calibrator benchmark_runtime`) and
+// Results of the runtime benchmark (`rig_calibrator_lab benchmark_runtime`) and
 // their reports: Markdown tables, CSV files and an SVG plot of the
 // calibration time against the number of framesets.
 //

@@ -1,7 +1,7 @@
-// The options of the runtime benchmark (`rig_calibrator benchmark_runtime`),
-// shared by the parent process, which runs every measurement in a child
-// process, and the children, which get the parent's options plus the
-// hidden ChildRequest.
+// The options of the runtime benchmark (`rig_calibrator_lab
+// benchmark_runtime`), shared by the parent process, which runs every
+// measurement in a child process, and the children, which get the parent's
+// options plus the hidden ChildRequest.
 #pragma once
 
 #include <string>

@@ -311,7 +311,7 @@ std::string RuntimeMarkdown(
     const std::vector<LocalizationRuntime>& localization_runs) {
   std::ostringstream md;
   md << "# Runtime benchmark\n\n"
-     << "Measured by `rig_calibrator benchmark_runtime` on a machine with "
+     << "Measured by `rig_calibrator_lab benchmark_runtime` on a machine with "
      << machine_before << " at the start and " << MachineDescription()
      << " at the end. CPU seconds (user + system over all threads) depend "
         "less on other work on the machine than wall seconds do.\n\n";

@@ -84,7 +84,7 @@ boost::program_options::options_description DescribeCalibrateOptions(
     CalibrateOptions* options);
 
 // The Localization.* and SiftMatching.* options alone (also those of
-// `rig_calibrator benchmark_localization`).
+// `rig_calibrator_lab benchmark_localization`).
 boost::program_options::options_description DescribeLocalizationOptions(
     CalibrateOptions* options);
 

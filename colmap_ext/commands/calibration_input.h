@@ -12,7 +12,7 @@
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/io/calibration_summary.h"
 #include "colmap_ext/io/rig_layout.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -18,18 +18,6 @@ void AddOverwriteOption(po::options_description* description, bool* overwrite) {
             "replace a non-empty output folder");
 }
 
-void AddSyntheticDataOptions(po::options_description* description,
-                             SyntheticRigOptions* options) {
-  AddOption(description, "points_per_image", &options->points_per_image,
-            "correspondences per image");
-  AddOption(description, "noise_px", &options->noise_px,
-            "pixel noise (standard deviation)");
-  AddOption(description, "outlier_ratio", &options->outlier_ratio,
-            "share of wrong 2D-3D matches");
-  AddOption(description, "missing_image_ratio", &options->missing_image_ratio,
-            "share of images dropped");
-}
-
 std::optional<int> ParseCommandLine(int argc, char** argv,
                                     const po::options_description& description,
                                     const std::string& title) {

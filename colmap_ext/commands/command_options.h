@@ -8,7 +8,6 @@
 #include <string>
 
 #include "colmap_ext/io/error_output.h"
-#include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
 
@@ -48,12 +47,6 @@ void AddRequiredOption(boost::program_options::options_description* description,
 // --overwrite: replace a non-empty output folder.
 void AddOverwriteOption(
     boost::program_options::options_description* description, bool* overwrite);
-
-// The synthetic data of `rig_calibrator synthetic` and `benchmark_runtime`:
-// --points_per_image, --noise_px, --outlier_ratio, --missing_image_ratio.
-void AddSyntheticDataOptions(
-    boost::program_options::options_description* description,
-    SyntheticRigOptions* options);
 
 // Parses argv into the variables bound in `description`. Returns nothing if
 // the command should run, else its exit code after printing the help (`-h`,

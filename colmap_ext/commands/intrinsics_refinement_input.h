@@ -3,7 +3,7 @@
 // refine_extra_params, each "1" / "0" for every camera or per camera
 // ("cam0:0,cam1:1"; a bare value is the default of the cameras not named,
 // which are otherwise refined), and the given values of the parameters they
-// hold (src/calibration/intrinsics_refinement.h).
+// hold (src/rig/intrinsics_refinement.h).
 //
 // Where a held parameter's value comes from:
 //  - the known* methods: the given intrinsics they run with
@@ -24,7 +24,7 @@
 
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/io/database_reader.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -4,11 +4,11 @@
 //                  --input_path ... --output_path ...
 //   rig_calibrator evaluate ...
 //   rig_calibrator report --calibration_path ...
-//   rig_calibrator synthetic | render | benchmark | benchmark_runtime ...
 //
 // The first form is the default command; `rig_calibrator help` lists all.
 // The same commands are `colmap rig_calibrator ...` of the extended colmap
-// executable (colmap_main.cc).
+// executable (colmap_main.cc). Synthetic data, rendering and benchmarks are
+// the lab's (rig_calibrator_lab, colmap_ext/lab_commands/main.cc).
 #include "colmap_ext/commands/rig_calibrator_command.h"
 
 int main(int argc, char** argv) {

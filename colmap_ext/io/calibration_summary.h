@@ -14,13 +14,13 @@
 #include <utility>
 #include <vector>
 
+#include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
-#include "src/calibration/intrinsics_refinement.h"
+#include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
-#include "src/calibration/rig_dataset.h"
-#include "src/evaluation/calibration_uncertainty.h"
-#include "src/evaluation/image_coverage.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/intrinsics_refinement.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 
@@ -104,7 +104,7 @@ struct CalibrationSummary {
 // sets method, seed, units, map_looks_metric, diagnostics and timings. Camera
 // names come from the dataset, image prefixes from `image_prefixes` (one per
 // camera, or empty for name + "/"). cam_from_rig is relative to the reference
-// camera. Requires ValidateCalibration (src/calibration/rig_dataset.h).
+// camera. Requires ValidateCalibration (src/rig/rig_dataset.h).
 CalibrationSummary SummarizeCalibration(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);

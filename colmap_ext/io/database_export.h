@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <string>
 
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -29,7 +29,7 @@
 #include "colmap_ext/io/camera_records_io.h"
 #include "colmap_ext/io/model_errors.h"
 #include "colmap_ext/io/rigs_frames_io.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "src/calibration/rig_dataset.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 
@@ -41,7 +41,7 @@ struct RigDescription {
 // the solver left). Cameras with camera_calibrated false have neither
 // intrinsics nor cam_from_rig. `image_prefixes` (one per camera) may be empty:
 // the prefix is then the camera's name followed by '/'. Requires
-// ValidateCalibration (src/calibration/rig_dataset.h).
+// ValidateCalibration (src/rig/rig_dataset.h).
 RigDescription DescribeCalibratedRig(
     const RigDataset& dataset, const RigCalibration& calibration,
     const std::vector<std::string>& image_prefixes);

@@ -1,4 +1,4 @@
-// The uncertainty of a calibration (src/evaluation/calibration_uncertainty.h)
+// The uncertainty of a calibration (src/calibration/calibration_uncertainty.h)
 // in the outputs: the "uncertainty" of every camera and the top-level
 // "uncertainty_method" of calibration_summary.json, the comment lines of
 // camchain.yaml, and the terminal lines of the result. Pixels are COLMAP's;
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "colmap_ext/io/rig_description.h"
-#include "src/evaluation/calibration_uncertainty.h"
+#include "src/calibration/calibration_uncertainty.h"
 
 namespace rig_calibrator {
 

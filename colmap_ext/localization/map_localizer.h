@@ -39,7 +39,7 @@
 #include "colmap_ext/localization/localization_map.h"
 #include "colmap_ext/localization/point_descriptor_index.h"
 #include "colmap_ext/localization/radial_guided_matching.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

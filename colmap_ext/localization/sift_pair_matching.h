@@ -6,7 +6,7 @@
 // seed give the same matches. COLMAP's own function builds an unseeded forest
 // per image pair inside its library; its exhaustive variant is deterministic
 // but took 12.1 instead of 2.3 CPU s per rig image (2000 features, 10
-// retrieved map images; rig_calibrator benchmark_runtime).
+// retrieved map images; rig_calibrator_lab benchmark_runtime).
 #pragma once
 
 #include <colmap/feature/sift.h>

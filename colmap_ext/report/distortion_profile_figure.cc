@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

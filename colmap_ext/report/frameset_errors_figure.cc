@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 

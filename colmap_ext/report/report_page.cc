@@ -18,7 +18,7 @@
 #include "colmap_ext/report/report_tables.h"
 #include "colmap_ext/report/residual_field_figure.h"
 #include "colmap_ext/report/rig_view_figure.h"
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

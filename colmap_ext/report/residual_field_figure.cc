@@ -7,7 +7,7 @@
 
 #include "colmap_ext/report/figure_format.h"
 #include "colmap_ext/report/heat_map_figure.h"
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "colmap_ext/report/figure_format.h"
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {

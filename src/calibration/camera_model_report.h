@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "src/calibration/model_selection.h"
-#include "src/evaluation/model_validity.h"
+#include "src/calibration/model_validity.h"
 
 namespace rig_calibrator {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

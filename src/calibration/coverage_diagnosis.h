@@ -1,10 +1,10 @@
 // The coverage of every calibrated camera's image by its final inliers
-// (src/evaluation/image_coverage.h), in the pipeline's report, and a
+// (src/calibration/image_coverage.h), in the pipeline's report, and a
 // "poor_coverage" warning with the numbers for each camera it finds poor.
 #pragma once
 
 #include "src/calibration/pipeline_report.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

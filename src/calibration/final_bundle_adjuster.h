@@ -23,7 +23,7 @@
 
 #include <string>
 
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "src/calibration/camera_upgrader.h"
-#include "src/calibration/rig_dataset.h"
 #include "src/estimators/radial_pose_estimator.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -5,7 +5,7 @@
 // posed by the other cameras.
 #pragma once
 
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

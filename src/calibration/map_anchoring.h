@@ -15,7 +15,7 @@
 // were adjusted too, their camera centres with the input map's.
 #pragma once
 
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

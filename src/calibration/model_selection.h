@@ -46,7 +46,7 @@
 #include <vector>
 
 #include "src/calibration/camera_upgrader.h"
-#include "src/evaluation/model_validity.h"
+#include "src/calibration/model_validity.h"
 
 namespace rig_calibrator {
 

@@ -27,8 +27,8 @@
 #include "src/calibration/pipeline_report.h"
 #include "src/calibration/principal_axes.h"
 #include "src/calibration/radial_bundle_adjuster.h"
-#include "src/calibration/rig_dataset.h"
 #include "src/calibration/rig_initializer.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "src/calibration/calibration_method.h"
+#include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
-#include "src/calibration/intrinsics_refinement.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
-#include "src/evaluation/calibration_uncertainty.h"
-#include "src/evaluation/image_coverage.h"
+#include "src/rig/intrinsics_refinement.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

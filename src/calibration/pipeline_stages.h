@@ -48,7 +48,7 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
                                   "Final bundle adjustment");
 
 // The uncertainty of the final bundle adjustment's result
-// (src/evaluation/calibration_uncertainty.h) into report->uncertainty, and
+// (src/calibration/calibration_uncertainty.h) into report->uncertainty, and
 // its diagnostics. Never fails the calibration.
 void RunUncertaintyEstimation(const PipelineOptions& options,
                               CalibrationMethod method,

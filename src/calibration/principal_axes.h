@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "src/calibration/rig_dataset.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "src/calibration/final_bundle_adjuster.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_solver.h"
 
 namespace rig_calibrator {

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "src/calibration/rig_dataset.h"
 #include "src/calibration/rig_initializer.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 namespace rig_init {

@@ -26,7 +26,7 @@
 #include <string>
 
 #include "src/calibration/principal_axes.h"
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 

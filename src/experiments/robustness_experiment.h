@@ -1,8 +1,8 @@
 // The paper's robustness experiment (§5.3, Table 3) and its evaluation of the
 // initial estimates (§5.4, Fig. 6) over rig presets, scenes and difficulties:
 // each cell runs the short-sequence experiment
-// (src/experiments/short_sequence_experiment.h) and the results become tables,
-// CSV and plots.
+// (src/experiments/short_sequence_experiment.h) and the results become tables
+// and CSV (the plots: colmap_ext/lab_commands/robustness_figures.h).
 #pragma once
 
 #include <functional>
@@ -61,16 +61,5 @@ std::string FormatRobustnessDetails(const std::vector<RobustnessCell>& cells);
 
 // One row per cell and method.
 std::string RobustnessCsv(const std::vector<RobustnessCell>& cells);
-
-// Paper Fig. 6: cumulative distributions, over every camera of every
-// sequence of the cell, of the rotation (`rotation` true, degrees) or center
-// (cm) error of the rig before the final bundle adjustment, one curve per
-// method; with `final_errors` the errors after it instead.
-std::string ErrorDistributionSvg(const RobustnessCell& cell, bool rotation,
-                                 bool final_errors);
-
-// Grouped bars of the share of good calibrations: one group per cell, one
-// bar per method.
-std::string GoodCalibrationsSvg(const std::vector<RobustnessCell>& cells);
 
 }  // namespace rig_calibrator

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "colmap_ext/commands/commands.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
 #include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 

@@ -10,6 +10,7 @@ set -u
 
 BUILD_DIR=$(cd "$1" && pwd)
 BIN=$BUILD_DIR/rig_calibrator
+LAB=$BUILD_DIR/rig_calibrator_lab
 WORK=$(mktemp -d /tmp/degenerate_inputs.XXXXXX)
 trap 'rm -rf "$WORK"' EXIT
 
@@ -21,7 +22,7 @@ sums() { (cd "$1" && find . -type f | sort | xargs sha256sum); }
 synthetic() {  # synthetic NAME OPTIONS...
   local name=$1
   shift
-  "$BIN" synthetic --output_path "$WORK/$name" --num_framesets 15 \
+  "$LAB" synthetic --output_path "$WORK/$name" --num_framesets 15 \
     --points_per_image 200 --seed 4 "$@" >"$WORK/$name.synthetic.log" ||
     fail "synthetic $name: $(tail -2 "$WORK/$name.synthetic.log")"
 }

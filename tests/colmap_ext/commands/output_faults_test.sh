@@ -15,6 +15,7 @@ set -u
 BUILD_DIR=$(cd "$1" && pwd)
 NUM_KILL_TRIALS=${2:-20}
 BIN=$BUILD_DIR/rig_calibrator
+LAB=$BUILD_DIR/rig_calibrator_lab
 WORK=$(mktemp -d /tmp/output_faults.XXXXXX)
 MOUNTS=()
 cleanup() {
@@ -29,9 +30,9 @@ fail() {
 }
 
 # A small dataset: the run takes about a second, most of it calibration.
-"$BIN" synthetic --output_path "$WORK/data" --preset stereo_pair \
+"$LAB" synthetic --output_path "$WORK/data" --preset stereo_pair \
   --num_framesets 12 --points_per_image 300 --seed 3 >"$WORK/synthetic.log" ||
-  fail "rig_calibrator synthetic: $(cat "$WORK/synthetic.log")"
+  fail "rig_calibrator_lab synthetic: $(cat "$WORK/synthetic.log")"
 INPUT_SUMS=$(cd "$WORK/data" && find . -type f | sort | xargs sha256sum)
 CALIBRATE=("$BIN" --correspondences_path "$WORK/data/correspondences.txt"
   --RigCalibrator.camera_model OPENCV --RigCalibrator.num_threads 1)

@@ -16,7 +16,8 @@
 
 #include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/rig_reference_io.h"
-#include "src/calibration/intrinsics_refinement.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
+#include "src/rig/intrinsics_refinement.h"
 #include "tests/colmap_ext/colmap_testing.h"
 #include "tests/testing.h"
 

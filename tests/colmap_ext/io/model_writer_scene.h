@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "colmap_ext/io/rigs_frames_io.h"
-#include "src/calibration/rig_dataset.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 namespace testing {

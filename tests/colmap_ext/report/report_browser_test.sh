@@ -15,6 +15,7 @@ build="$(cd "$1" && pwd)"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 check="$here/check_report_in_browser.py"
 rig_calibrator="$build/rig_calibrator"
+rig_calibrator_lab="$build/rig_calibrator_lab"
 work="$build/report_browser_test"
 rm -rf "$work"
 mkdir -p "$work"
@@ -28,7 +29,7 @@ if ! command -v chromium >/dev/null 2>&1; then
   exit 1
 fi
 
-"$rig_calibrator" synthetic --preset fisheye_helmet5 --num_framesets 12 \
+"$rig_calibrator_lab" synthetic --preset fisheye_helmet5 --num_framesets 12 \
   --output_path "$work/data" > "$work/synthetic.log"
 models="$(grep -o 'camera_model [^ ]*' "$work/synthetic.log" | cut -d' ' -f2)"
 "$rig_calibrator" --correspondences_path "$work/data/correspondences.txt" \

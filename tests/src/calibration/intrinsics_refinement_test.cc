@@ -2,7 +2,7 @@
 // held parameter keeps the dataset camera's value bit for bit through every
 // method's stages, the others are still estimated, and holding the true
 // principal point is at least as accurate as estimating it.
-#include "src/calibration/intrinsics_refinement.h"
+#include "src/rig/intrinsics_refinement.h"
 
 #include <gtest/gtest.h>
 

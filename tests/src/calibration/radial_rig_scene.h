@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "src/calibration/principal_axes.h"
-#include "src/calibration/rig_dataset.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 namespace testing {

@@ -9,7 +9,7 @@ namespace rig_calibrator {
 namespace {
 
 // A smaller version of the README's 100-sequence experiment (run with
-// `rig_calibrator benchmark`): 1dr must calibrate almost every short
+// `rig_calibrator_lab benchmark`): 1dr must calibrate almost every short
 // sequence well.
 TEST(ShortSequenceExperiment, RadialMethodIsRobustOnShortSequences) {
   ShortSequenceOptions options;

@@ -1,4 +1,4 @@
-#include "src/calibration/intrinsics_refinement.h"
+#include "src/rig/intrinsics_refinement.h"
 
 #include <algorithm>
 

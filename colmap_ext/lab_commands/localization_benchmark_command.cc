@@ -1,11 +1,12 @@
-// `rig_calibrator benchmark_localization`: the localization's throughput on a
-// COLMAP map (localization_benchmark.h), one configuration per run, so that
+// `rig_calibrator_lab benchmark_localization`: the localization's throughput on
+// a COLMAP map (localization_benchmark.h), one configuration per run, so that
 // scripts/benchmark_localization.sh can alternate configurations on the same
 // data and its peak memory is the run's own:
 //
-//   rig_calibrator benchmark_localization --database_path DB --input_path MAP
+//   rig_calibrator_lab benchmark_localization --database_path DB
+//       --input_path MAP
 //       [--label NAME] [--csv_path FILE] [--Localization.* ...]
-//   rig_calibrator benchmark_localization --write_synthetic_map DIR
+//   rig_calibrator_lab benchmark_localization --write_synthetic_map DIR
 //       --map_points N   (DIR/database.db and DIR/sparse: a synthetic map of
 //                         about N points, synthetic_map_database.h)
 #include <colmap/util/timer.h>
@@ -20,8 +21,8 @@
 #include "colmap_ext/benchmarks/synthetic_map_database.h"
 #include "colmap_ext/commands/calibrate_options.h"
 #include "colmap_ext/commands/command_options.h"
-#include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/map_reader.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
 
 namespace rig_calibrator {
 namespace {
@@ -42,7 +43,7 @@ struct BenchmarkLocalizationOptions {
 };
 
 int Fail(const std::string& message) {
-  std::cerr << "rig_calibrator benchmark_localization: " << message
+  std::cerr << "rig_calibrator_lab benchmark_localization: " << message
             << std::endl;
   return EXIT_FAILURE;
 }
@@ -150,7 +151,7 @@ int RunLocalizationBenchmark(int argc, char** argv) {
   BenchmarkLocalizationOptions options;
   CalibrateOptions localization;
   po::options_description description =
-      CommandOptions("rig_calibrator benchmark_localization options");
+      CommandOptions("rig_calibrator_lab benchmark_localization options");
   AddOption(&description, "database_path", &options.database_path,
             "COLMAP database with the map and the rig images' features");
   AddOption(&description, "input_path", &options.input_path,
@@ -176,7 +177,7 @@ int RunLocalizationBenchmark(int argc, char** argv) {
   description.add(DescribeLocalizationOptions(&localization));
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, description,
-          "rig_calibrator benchmark_localization: localization throughput "
+          "rig_calibrator_lab benchmark_localization: localization throughput "
           "on a COLMAP map")) {
     return *exit_code;
   }

@@ -3,7 +3,7 @@
 // 150-degree fisheye lens. AddResidualProfileCheck on residual profiles
 // with and without a systematic radial misfit: the verdict, the suggested
 // model by lens width and kind, and the message.
-#include "src/evaluation/model_validity.h"
+#include "src/calibration/model_validity.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "src/evaluation/image_coverage.h"
+#include "src/calibration/image_coverage.h"
 
 #include <algorithm>
 #include <cmath>

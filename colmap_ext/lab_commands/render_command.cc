@@ -1,4 +1,4 @@
-#include "colmap_ext/commands/render_command.h"
+#include "colmap_ext/lab_commands/render_command.h"
 
 #include <colmap/base/reconstruction.h>
 #include <colmap/util/timer.h>
@@ -269,7 +269,7 @@ int RunRender(int argc, char** argv) {
   std::string output_path;
   bool overwrite = false;
   po::options_description description =
-      CommandOptions("rig_calibrator render options");
+      CommandOptions("rig_calibrator_lab render options");
   AddRequiredOption(
       &description, "output_path", &output_path,
       "folder to write (map_images/, rig_images/, ground_truth/)");
@@ -301,7 +301,7 @@ int RunRender(int argc, char** argv) {
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, description,
-          "rig_calibrator render: renders a rig dataset with exact ground "
+          "rig_calibrator_lab render: renders a rig dataset with exact ground "
           "truth (a mapping sequence and a rig calibration sequence)")) {
     return *exit_code;
   }

@@ -12,8 +12,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "src/calibration/intrinsics_refinement.h"
 #include "src/geometry/rigid3d.h"
+#include "src/rig/intrinsics_refinement.h"
 
 namespace rig_calibrator {
 

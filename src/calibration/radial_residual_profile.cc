@@ -1,4 +1,4 @@
-#include "src/evaluation/radial_residual_profile.h"
+#include "src/calibration/radial_residual_profile.h"
 
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>

@@ -91,9 +91,9 @@
 
 namespace rig_calibrator {
 
-// Declared here, defined in src/calibration/ (final_bundle_adjuster.h,
-// rig_dataset.h, pipeline_report.h), so that the pipeline's report can hold
-// the result structs below.
+// Declared here, defined in final_bundle_adjuster.h, pipeline_report.h and
+// src/rig/rig_dataset.h, so that the pipeline's report can hold the result
+// structs below.
 struct FinalBundleAdjustmentOptions;
 struct RigDataset;
 struct RigCalibration;

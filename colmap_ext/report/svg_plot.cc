@@ -1,4 +1,4 @@
-#include "src/experiments/svg_plot.h"
+#include "colmap_ext/report/svg_plot.h"
 
 #include <algorithm>
 #include <cstdio>

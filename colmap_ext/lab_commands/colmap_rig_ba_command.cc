@@ -1,9 +1,9 @@
-// `rig_calibrator benchmark_colmap_rig_ba`: this project's final bundle
+// `rig_calibrator_lab benchmark_colmap_rig_ba`: this project's final bundle
 // adjustment against COLMAP 3.8's `rig_bundle_adjuster` on the same problem
 // from the same start, in one run (colmap_ext/benchmarks/
 // colmap_rig_ba_comparison.h):
 //
-//   rig_calibrator benchmark_colmap_rig_ba --output_path DIR
+//   rig_calibrator_lab benchmark_colmap_rig_ba --output_path DIR
 //       [--framesets 100,500] [--cameras 10] [--quick 1]
 //
 // DIR gets colmap_rig_ba.md (the table, with the machine's load) and
@@ -12,7 +12,8 @@
 
 #include "colmap_ext/benchmarks/colmap_rig_ba_comparison.h"
 #include "colmap_ext/commands/command_options.h"
-#include "colmap_ext/commands/commands.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
+#include "colmap_ext/lab_commands/synthetic_data_options.h"
 
 namespace rig_calibrator {
 
@@ -21,7 +22,7 @@ int RunColmapRigBaBenchmark(int argc, char** argv) {
   ColmapRigBaComparisonOptions options;
   bool quick = false;
   po::options_description description =
-      CommandOptions("rig_calibrator benchmark_colmap_rig_ba options");
+      CommandOptions("rig_calibrator_lab benchmark_colmap_rig_ba options");
   AddRequiredOption(&description, "output_path", &options.output_path,
                     "results folder (created if needed): colmap_rig_ba.md, "
                     "colmap_rig_ba.csv");
@@ -49,7 +50,7 @@ int RunColmapRigBaBenchmark(int argc, char** argv) {
             "keep the COLMAP models and logs (the path is printed)");
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, description,
-          "rig_calibrator benchmark_colmap_rig_ba: our final bundle "
+          "rig_calibrator_lab benchmark_colmap_rig_ba: our final bundle "
           "adjustment vs COLMAP 3.8 rig_bundle_adjuster")) {
     return *exit_code;
   }
@@ -59,7 +60,7 @@ int RunColmapRigBaBenchmark(int argc, char** argv) {
   }
   std::string error;
   if (!RunColmapRigBaComparison(options, &error)) {
-    std::cerr << "rig_calibrator benchmark_colmap_rig_ba: " << error
+    std::cerr << "rig_calibrator_lab benchmark_colmap_rig_ba: " << error
               << std::endl;
     return EXIT_FAILURE;
   }

@@ -34,7 +34,7 @@
 #include <optional>
 #include <string>
 
-#include "src/evaluation/radial_residual_profile.h"
+#include "src/calibration/radial_residual_profile.h"
 
 namespace rig_calibrator {
 

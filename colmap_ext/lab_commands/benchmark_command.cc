@@ -1,4 +1,4 @@
-// `rig_calibrator benchmark`: the paper's experiments on synthetic rigs.
+// `rig_calibrator_lab benchmark`: the paper's experiments on synthetic rigs.
 //  --experiment short_sequence (default): one robustness table (paper §5.3)
 //    for one preset, scene and difficulty, on the terminal and, with
 //    --output_path, in that Markdown file.
@@ -14,12 +14,12 @@
 #include <iostream>
 
 #include "colmap_ext/commands/command_options.h"
-#include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
+#include "colmap_ext/lab_commands/robustness_figures.h"
 #include "src/experiments/accuracy_experiment.h"
 #include "src/experiments/robustness_experiment.h"
 #include "src/experiments/short_sequence_experiment.h"
-#include "src/experiments/svg_plot.h"
 
 namespace rig_calibrator {
 namespace {
@@ -225,7 +225,7 @@ bool ParseMethods(const std::string& names,
 boost::program_options::options_description Describe(
     BenchmarkCommandOptions* o) {
   boost::program_options::options_description description =
-      CommandOptions("rig_calibrator benchmark options");
+      CommandOptions("rig_calibrator_lab benchmark options");
   AddOption(&description, "experiment", &o->experiment,
             "short_sequence (one robustness table), accuracy, robustness or "
             "all");
@@ -353,7 +353,7 @@ int RunBenchmark(int argc, char** argv) {
   BenchmarkCommandOptions options;
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, Describe(&options),
-          "rig_calibrator benchmark: the paper's accuracy (§5.2) and "
+          "rig_calibrator_lab benchmark: the paper's accuracy (§5.2) and "
           "robustness (§5.3, §5.4) experiments on synthetic rigs")) {
     return *exit_code;
   }

@@ -1,4 +1,4 @@
-// `rig_calibrator synthetic`: writes a synthetic rig dataset (2D-3D
+// `rig_calibrator_lab synthetic`: writes a synthetic rig dataset (2D-3D
 // correspondences) and its exact ground truth, to try the calibration or to
 // feed benchmarks without images.
 #include <boost/filesystem.hpp>
@@ -6,12 +6,13 @@
 
 #include "colmap_ext/benchmarks/synthetic_map_model.h"
 #include "colmap_ext/commands/command_options.h"
-#include "colmap_ext/commands/commands.h"
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/camchain_io.h"
 #include "colmap_ext/io/correspondence_io.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
+#include "colmap_ext/lab_commands/synthetic_data_options.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
@@ -39,7 +40,7 @@ int RunSynthetic(int argc, char** argv) {
   bool overwrite = false;
   int seed = 0;
   boost::program_options::options_description description =
-      CommandOptions("rig_calibrator synthetic options");
+      CommandOptions("rig_calibrator_lab synthetic options");
   AddRequiredOption(&description, "output_path", &output_path,
                     "output folder: correspondences.txt and ground_truth/");
   AddOption(&description, "preset", &preset,
@@ -78,8 +79,8 @@ int RunSynthetic(int argc, char** argv) {
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, description,
-          "rig_calibrator synthetic: write a synthetic rig dataset with exact "
-          "ground truth")) {
+          "rig_calibrator_lab synthetic: write a synthetic rig dataset with "
+          "exact ground truth")) {
     return *exit_code;
   }
   if (!RigPresetFromName(preset, &options.preset)) {

@@ -1,4 +1,4 @@
-#include "src/evaluation/model_validity.h"
+#include "src/calibration/model_validity.h"
 
 #include <colmap/base/camera_models.h>
 #include <colmap/util/math.h>

@@ -1,4 +1,4 @@
-#include "src/evaluation/calibration_uncertainty.h"
+#include "src/calibration/calibration_uncertainty.h"
 
 #include <colmap/base/camera_models.h>
 #include <colmap/util/math.h>
@@ -20,8 +20,8 @@
 
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/pipeline_report.h"
-#include "src/calibration/rig_dataset.h"
 #include "src/geometry/rig_reprojection_cost.h"
+#include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
 namespace {

@@ -2,7 +2,7 @@
 // 1e-12), on pure noise over many seeds (no false alarm, z of unit spread),
 // on a radial bias of known shape in noise (found, its ring and numbers), on
 // a bias below the floor with many points, and on too few points.
-#include "src/evaluation/radial_residual_profile.h"
+#include "src/calibration/radial_residual_profile.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // ValidateCalibration: a calibration shaped like its dataset, with finite
 // poses and inlier masks of the right length; every other shape fails with a
 // message naming what is wrong.
-#include "src/calibration/rig_dataset.h"
+#include "src/rig/rig_dataset.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "src/evaluation/calibration_uncertainty.h"
+#include "src/calibration/calibration_uncertainty.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// `rig_calibrator render`: renders a rig dataset with exact ground truth
+// `rig_calibrator_lab render`: renders a rig dataset with exact ground truth
 // (src/synthetic/rendered_dataset.h, src/synthetic/scene_renderer.h) into a
 // folder:
 //
@@ -40,7 +40,7 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
                           const std::string& output_path, bool overwrite,
                           std::string* error);
 
-// rig_calibrator render --output_path DIR [--preset ring5] [--scene room]
+// rig_calibrator_lab render --output_path DIR [--preset ring5] [--scene room]
 //   [--num_map_images 60] [--num_framesets 12] [--seed 0] ...
 int RunRender(int argc, char** argv);
 

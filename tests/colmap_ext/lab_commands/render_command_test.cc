@@ -1,4 +1,4 @@
-#include "colmap_ext/commands/render_command.h"
+#include "colmap_ext/lab_commands/render_command.h"
 
 #include <colmap/base/reconstruction.h>
 #include <gtest/gtest.h>

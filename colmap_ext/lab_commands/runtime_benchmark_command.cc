@@ -1,5 +1,5 @@
-// `rig_calibrator benchmark_runtime`: how long the calibration takes and how
-// much memory it needs (issue targets: the calibration core for 500
+// `rig_calibrator_lab benchmark_runtime`: how long the calibration takes and
+// how much memory it needs (issue targets: the calibration core for 500
 // framesets x 10 cameras x ~300 correspondences in under 60 s on 2 cores,
 // growing about linearly with the framesets; localization of at least 5 rig
 // images per second against a 300-image map).
@@ -22,7 +22,8 @@
 #include "colmap_ext/benchmarks/runtime_benchmark_options.h"
 #include "colmap_ext/benchmarks/runtime_benchmark_runner.h"
 #include "colmap_ext/commands/command_options.h"
-#include "colmap_ext/commands/commands.h"
+#include "colmap_ext/lab_commands/lab_commands.h"
+#include "colmap_ext/lab_commands/synthetic_data_options.h"
 
 namespace rig_calibrator {
 namespace {
@@ -102,7 +103,7 @@ po::options_description ChildOptions(ChildRequest* request) {
 int RunRuntimeBenchmark(int argc, char** argv) {
   RuntimeBenchmarkOptions options;
   po::options_description description =
-      CommandOptions("rig_calibrator benchmark_runtime options");
+      CommandOptions("rig_calibrator_lab benchmark_runtime options");
   AddCalibrationRunOptions(&description, &options);
   AddLocalizationRunOptions(&description, &options);
   po::options_description all;
@@ -115,7 +116,7 @@ int RunRuntimeBenchmark(int argc, char** argv) {
   }
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, wants_help ? description : all,
-          "rig_calibrator benchmark_runtime: time and memory of the "
+          "rig_calibrator_lab benchmark_runtime: time and memory of the "
           "calibration core and of the localization")) {
     return *exit_code;
   }
