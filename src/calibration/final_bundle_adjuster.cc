@@ -65,7 +65,7 @@ constexpr double kPruningFunctionTolerance = 1e-3;
 bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
                       RigAdjustment* adjustment,
                       FinalBundleAdjustmentSummary* result) {
-  BundleLevenbergMarquardtSummary solver_summary;
+  BundleSolverSummary solver_summary;
   bool nothing_pruned = false;
   for (int round = 0;; ++round) {
     const bool last = round >= options.num_pruning_rounds;

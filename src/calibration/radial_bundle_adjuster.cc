@@ -103,7 +103,7 @@ std::vector<Observation> KeepDeterminedFramesets(
 // t_z; holding one removes that null direction). The principal points of
 // the cameras whose refinement holds them stay constant. A camera's
 // cam_from_rig and principal point are one block row.
-BundleLevenbergMarquardtSummary Solve(
+BundleSolverSummary Solve(
     const RadialBundleAdjustmentOptions& options,
     const std::vector<Observation>& observations, int reference_camera,
     const std::vector<RigCamera>& cameras, Parameters* parameters) {
@@ -115,7 +115,7 @@ BundleLevenbergMarquardtSummary Solve(
     cam_added[observation.camera] = 1;
     rig_added[observation.frameset] = 1;
   }
-  BundleLevenbergMarquardtOptions solver_options;
+  BundleSolverOptions solver_options;
   solver_options.max_num_iterations = options.max_num_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   // Noisy problems stop on the relative cost change (1e-6); this lets exact
@@ -169,7 +169,7 @@ BundleLevenbergMarquardtSummary Solve(
          parameters->rig_from_world[observation.frameset].data(),
          parameters->principal_points[observation.camera].data()});
   }
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   solver.Solve(&summary);
   VLOG(1) << "Radial bundle adjustment: " << summary.BriefReport();
   return summary;
@@ -401,7 +401,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
   // correspondences within max_radial_error_px are dropped whole (a few of a
   // wrong image's points always fall near the predicted lines), the
   // remaining correspondences beyond it too, and the rest solved again.
-  BundleLevenbergMarquardtSummary solver_summary =
+  BundleSolverSummary solver_summary =
       Solve(options, observations, reference, dataset.cameras, &parameters);
   int num_iterations = solver_summary.num_successful_steps +
                        solver_summary.num_unsuccessful_steps;

@@ -61,7 +61,7 @@ class RigAdjustment {
   // an iteration lowers the cost by less than function_tolerance of it.
   // False (logged) when the solver finds no usable solution.
   bool Solve(double function_tolerance,
-             BundleLevenbergMarquardtSummary* summary);
+             BundleSolverSummary* summary);
 
   // Writes the estimate and the per-image results (see AdjustRig).
   void WriteTo(RigCalibration* calibration) const;

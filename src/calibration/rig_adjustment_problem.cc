@@ -11,12 +11,12 @@
 namespace rig_calibrator {
 
 bool RigAdjustment::Solve(double function_tolerance,
-                          BundleLevenbergMarquardtSummary* summary) {
+                          BundleSolverSummary* summary) {
   if (options_.refine_points && !selection_current_) {
     SelectRefinedPoints();
   }
   if (solver_ == nullptr) {
-    BundleLevenbergMarquardtOptions solver_options;
+    BundleSolverOptions solver_options;
     solver_options.max_num_iterations = options_.max_num_iterations;
     // Exact data converges quadratically; a parameter tolerance relative to
     // the whole parameter vector (dominated by the focal lengths) of Ceres'

@@ -198,13 +198,13 @@ struct BundleLevenbergMarquardt::Impl {
     size_t offset = 0;  // row-major rows x cols in the value arrays
   };
 
-  explicit Impl(const BundleLevenbergMarquardtOptions& o) : options(o) {
+  explicit Impl(const BundleSolverOptions& o) : options(o) {
     // Not positive definite is an answer (the step is rejected), not a
     // message on stderr.
     cholesky.cholmod().print = 0;
   }
 
-  BundleLevenbergMarquardtOptions options;
+  BundleSolverOptions options;
   std::vector<Block> blocks;
   std::vector<Group> groups;
   std::unordered_map<const double*, int> block_index;
@@ -1143,7 +1143,7 @@ double BundleLevenbergMarquardt::Impl::GradientMaxNorm() const {
 }
 
 BundleLevenbergMarquardt::BundleLevenbergMarquardt(
-    const BundleLevenbergMarquardtOptions& options)
+    const BundleSolverOptions& options)
     : impl_(std::make_unique<Impl>(options)) {}
 
 BundleLevenbergMarquardt::~BundleLevenbergMarquardt() = default;
@@ -1253,12 +1253,12 @@ size_t BundleLevenbergMarquardt::AddResidualBlock(
   return impl_->residuals.size() - 1;
 }
 
-void BundleLevenbergMarquardt::Solve(BundleLevenbergMarquardtSummary* summary) {
-  using Termination = BundleLevenbergMarquardtSummary::Termination;
+void BundleLevenbergMarquardt::Solve(BundleSolverSummary* summary) {
+  using Termination = BundleSolverSummary::Termination;
   Impl& impl = *impl_;
-  const BundleLevenbergMarquardtOptions& options = impl.options;
+  const BundleSolverOptions& options = impl.options;
   const auto start_time = std::chrono::steady_clock::now();
-  *summary = BundleLevenbergMarquardtSummary();
+  *summary = BundleSolverSummary();
   summary->num_residual_blocks = static_cast<int>(std::count_if(
       impl.residuals.begin(), impl.residuals.end(),
       [](const Impl::Residual& residual) { return residual.active; }));

@@ -1,6 +1,7 @@
-// Levenberg-Marquardt for bundle-adjustment problems: the final bundle
-// adjustment's own solver (final_bundle_adjuster.h), written for its fixed
-// structure instead of Ceres' general one.
+// Levenberg-Marquardt for bundle-adjustment problems: the own backend of the
+// bundle solver (bundle_solver.h; the default of the radial and the final
+// bundle adjustment, with Ceres' as the other backend), written for their
+// fixed structure instead of Ceres' general one.
 //
 // Problem. Residual blocks of 2 rows, r_t(x), each a ceres::CostFunction
 // (analytic Jacobians: rig_reprojection_cost.h) over up to three "camera
@@ -63,7 +64,7 @@ namespace rig_calibrator {
 class BundleLevenbergMarquardt final : public BundleSolver {
  public:
   explicit BundleLevenbergMarquardt(
-      const BundleLevenbergMarquardtOptions& options);
+      const BundleSolverOptions& options);
   ~BundleLevenbergMarquardt() override;
 
   void AddParameterBlock(double* values, int size,
@@ -83,7 +84,7 @@ class BundleLevenbergMarquardt final : public BundleSolver {
   void SetFunctionTolerance(double tolerance) override;
 
   // After a failure midway, the values are the last accepted estimate.
-  void Solve(BundleLevenbergMarquardtSummary* summary) override;
+  void Solve(BundleSolverSummary* summary) override;
 
  private:
   struct Impl;

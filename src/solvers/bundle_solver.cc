@@ -7,7 +7,7 @@
 
 namespace rig_calibrator {
 
-std::string BundleLevenbergMarquardtSummary::BriefReport() const {
+std::string BundleSolverSummary::BriefReport() const {
   std::ostringstream report;
   report << "Bundle Levenberg-Marquardt: Iterations: "
          << num_successful_steps + num_unsuccessful_steps
@@ -38,7 +38,7 @@ std::string BundleSolverBackendName(BundleSolverBackend backend) {
 
 std::unique_ptr<BundleSolver> MakeBundleSolver(
     BundleSolverBackend backend,
-    const BundleLevenbergMarquardtOptions& options) {
+    const BundleSolverOptions& options) {
   if (backend == BundleSolverBackend::kCeres) {
     return std::make_unique<CeresBundleSolver>(options);
   }

@@ -39,7 +39,7 @@
 
 namespace rig_calibrator {
 
-struct BundleLevenbergMarquardtOptions {
+struct BundleSolverOptions {
   int max_num_iterations = 100;
   double function_tolerance = 1e-6;
   double parameter_tolerance = 1e-8;
@@ -53,7 +53,7 @@ struct BundleLevenbergMarquardtOptions {
   bool print_progress = false;
 };
 
-struct BundleLevenbergMarquardtSummary {
+struct BundleSolverSummary {
   enum class Termination { kConvergence, kNoConvergence, kFailure };
   Termination termination = Termination::kFailure;
   std::string message;
@@ -111,7 +111,7 @@ class BundleSolver {
   // Minimizes F from the current values, which it updates (the last accepted
   // estimate; after a failure the values are the backend's last accepted
   // ones or the initial ones, and are not to be used).
-  virtual void Solve(BundleLevenbergMarquardtSummary* summary) = 0;
+  virtual void Solve(BundleSolverSummary* summary) = 0;
 };
 
 enum class BundleSolverBackend { kOwn, kCeres };
@@ -123,6 +123,6 @@ std::string BundleSolverBackendName(BundleSolverBackend backend);
 
 std::unique_ptr<BundleSolver> MakeBundleSolver(
     BundleSolverBackend backend,
-    const BundleLevenbergMarquardtOptions& options);
+    const BundleSolverOptions& options);
 
 }  // namespace rig_calibrator

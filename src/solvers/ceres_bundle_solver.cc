@@ -22,7 +22,7 @@ constexpr int kCameraSideGroup = 1;
 }  // namespace
 
 CeresBundleSolver::CeresBundleSolver(
-    const BundleLevenbergMarquardtOptions& options)
+    const BundleSolverOptions& options)
     : options_(options) {}
 
 void CeresBundleSolver::AddParameterBlock(double* values, int size,
@@ -65,10 +65,10 @@ void CeresBundleSolver::SetFunctionTolerance(double tolerance) {
   options_.function_tolerance = tolerance;
 }
 
-void CeresBundleSolver::Solve(BundleLevenbergMarquardtSummary* summary) {
-  using Termination = BundleLevenbergMarquardtSummary::Termination;
+void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
+  using Termination = BundleSolverSummary::Termination;
   const auto start_time = std::chrono::steady_clock::now();
-  *summary = BundleLevenbergMarquardtSummary();
+  *summary = BundleSolverSummary();
 
   // Ceres only reads the costs, losses and manifolds; its interface takes
   // them non-const.

@@ -36,7 +36,7 @@ namespace rig_calibrator {
 
 class CeresBundleSolver final : public BundleSolver {
  public:
-  explicit CeresBundleSolver(const BundleLevenbergMarquardtOptions& options);
+  explicit CeresBundleSolver(const BundleSolverOptions& options);
 
   void AddParameterBlock(double* values, int size,
                          const ceres::Manifold* manifold, int group) override;
@@ -49,7 +49,7 @@ class CeresBundleSolver final : public BundleSolver {
   void SetPointHeld(const double* values, bool held) override;
   void SetFunctionTolerance(double tolerance) override;
   // After a failure, the values are the initial ones (Ceres restores them).
-  void Solve(BundleLevenbergMarquardtSummary* summary) override;
+  void Solve(BundleSolverSummary* summary) override;
 
  private:
   struct Block {
@@ -63,7 +63,7 @@ class CeresBundleSolver final : public BundleSolver {
     bool active = true;
   };
 
-  BundleLevenbergMarquardtOptions options_;
+  BundleSolverOptions options_;
   std::unordered_map<const double*, Block> blocks_;
   // Per point: held (SetPointHeld).
   std::unordered_map<const double*, bool> point_held_;

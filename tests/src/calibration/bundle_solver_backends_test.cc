@@ -329,7 +329,7 @@ BackendRun RunFinalAdjustment(const SyntheticRig& rig,
   BackendRun run;
   RigAdjustment adjustment(options, rig.dataset, start);
   adjustment.RejectOutliers(/*prune_residuals=*/false);
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   const auto solve = [&]() {
     EXPECT_TRUE(adjustment.Solve(kFunctionTolerance, &summary))
         << summary.BriefReport();
@@ -523,10 +523,10 @@ TEST(BundleSolverBackendsTest, UnconvergedSolveIsDetected) {
   options.max_num_iterations = 2;
   RigAdjustment adjustment(options, rig.dataset, start);
   adjustment.RejectOutliers(/*prune_residuals=*/false);
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   ASSERT_TRUE(adjustment.Solve(kFunctionTolerance, &summary));
   EXPECT_EQ(summary.termination,
-            BundleLevenbergMarquardtSummary::Termination::kNoConvergence);
+            BundleSolverSummary::Termination::kNoConvergence);
   RigCalibration stopped = start;
   adjustment.WriteTo(&stopped);
   EXPECT_GT(std::abs(own.final_cost / summary.final_cost - 1),

@@ -189,11 +189,11 @@ void BuildProblem(Scene* scene, Problem* problem, bool ambient_only = false) {
 }
 
 void SolveOurs(const ceres::LossFunction* loss, int num_threads, Scene* scene,
-               BundleLevenbergMarquardtSummary* summary,
+               BundleSolverSummary* summary,
                bool ambient_only = false) {
   Problem problem;
   BuildProblem(scene, &problem, ambient_only);
-  BundleLevenbergMarquardtOptions options;
+  BundleSolverOptions options;
   options.parameter_tolerance = 1e-12;
   options.function_tolerance = 1e-12;
   options.num_threads = num_threads;
@@ -290,10 +290,10 @@ TEST(BundleLevenbergMarquardtTest, RecoversExactSceneFromPerturbedStart) {
   const Errors start = Compare(scene, truth);
   ASSERT_GT(start.rotation_rad, 0.01);
   ASSERT_GT(start.focal_relative, 0.015);
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   SolveOurs(nullptr, -1, &scene, &summary);
   ASSERT_EQ(summary.termination,
-            BundleLevenbergMarquardtSummary::Termination::kConvergence)
+            BundleSolverSummary::Termination::kConvergence)
       << summary.BriefReport();
   EXPECT_GT(summary.initial_cost, 100);
   EXPECT_LT(summary.final_cost, 1e-16);
@@ -320,7 +320,7 @@ TEST(BundleLevenbergMarquardtTest, RobustSolveMatchesCeresAndIsAccurate) {
   const Scene start = Perturbed(truth, 4);
   ceres::CauchyLoss loss(1.0);
   Scene ours = start;
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   SolveOurs(&loss, 2, &ours, &summary);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
   Scene ceres = start;
@@ -347,7 +347,7 @@ TEST(BundleLevenbergMarquardtTest, TangentJacobiansGiveTheAmbientPathsSolve) {
   const Scene start = Perturbed(truth, 13);
   ceres::CauchyLoss loss(1.0);
   Scene tangent = start, ambient = start;
-  BundleLevenbergMarquardtSummary tangent_summary, ambient_summary;
+  BundleSolverSummary tangent_summary, ambient_summary;
   SolveOurs(&loss, 2, &tangent, &tangent_summary);
   SolveOurs(&loss, 2, &ambient, &ambient_summary, /*ambient_only=*/true);
   ASSERT_TRUE(tangent_summary.IsSolutionUsable());
@@ -370,7 +370,7 @@ TEST(BundleLevenbergMarquardtTest, ResultDoesNotDependOnThreadCount) {
   const Scene start = Perturbed(truth, 6);
   ceres::CauchyLoss loss(1.0);
   Scene one = start, two = start, three = start;
-  BundleLevenbergMarquardtSummary summary_one, summary_two, summary_three;
+  BundleSolverSummary summary_one, summary_two, summary_three;
   SolveOurs(&loss, 1, &one, &summary_one);
   SolveOurs(&loss, 2, &two, &summary_two);
   SolveOurs(&loss, 3, &three, &summary_three);
@@ -392,7 +392,7 @@ TEST(BundleLevenbergMarquardtTest, UnusableStartFailsAndLeavesValues) {
   // A refined point behind every camera: the residuals cannot be evaluated.
   scene.points.back() = Eigen::Vector3d(0, 0, -100);
   const Scene before = scene;
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   SolveOurs(nullptr, 2, &scene, &summary);
   EXPECT_FALSE(summary.IsSolutionUsable());
   EXPECT_NE(summary.message.find("initial values"), std::string::npos);
@@ -420,15 +420,15 @@ TEST(BundleLevenbergMarquardtTest, StopsAtTheIterationLimitAndContinues) {
   Scene scene = Perturbed(truth, 9);
   Problem problem;
   BuildProblem(&scene, &problem);
-  BundleLevenbergMarquardtOptions options;
+  BundleSolverOptions options;
   options.max_num_iterations = 2;
   options.function_tolerance = 0;
   BundleLevenbergMarquardt solver(options);
   AddCameraSideProblem(&scene, &problem, &solver);
-  BundleLevenbergMarquardtSummary first, second;
+  BundleSolverSummary first, second;
   solver.Solve(&first);
   EXPECT_EQ(first.termination,
-            BundleLevenbergMarquardtSummary::Termination::kNoConvergence);
+            BundleSolverSummary::Termination::kNoConvergence);
   EXPECT_EQ(first.num_successful_steps + first.num_unsuccessful_steps, 2);
   EXPECT_LT(first.final_cost, first.initial_cost);
   // Solving again continues from the result, on the same structure.
@@ -466,7 +466,7 @@ TEST(BundleLevenbergMarquardtTest, ConvergedStepIsKeptWithoutRelinearizing) {
   BuildProblem(&scene, &problem);
   std::atomic<int> num_linearizations{0};
   const CountingCost counting(problem.costs[0].get(), &num_linearizations);
-  BundleLevenbergMarquardtOptions options;
+  BundleSolverOptions options;
   options.function_tolerance = 1e-3;
   BundleLevenbergMarquardt solver(options);
   solver.AddParameterBlock(scene.intrinsics[0].data(), 4, nullptr, 0);
@@ -476,10 +476,10 @@ TEST(BundleLevenbergMarquardtTest, ConvergedStepIsKeptWithoutRelinearizing) {
     solver.AddResidualBlock(k == 0 ? &counting : problem.costs[k].get(),
                             nullptr, problem.parameters[k]);
   }
-  BundleLevenbergMarquardtSummary summary;
+  BundleSolverSummary summary;
   solver.Solve(&summary);
   ASSERT_EQ(summary.termination,
-            BundleLevenbergMarquardtSummary::Termination::kConvergence)
+            BundleSolverSummary::Termination::kConvergence)
       << summary.BriefReport();
   EXPECT_EQ(summary.message, "function tolerance reached");
   ASSERT_GE(summary.num_successful_steps, 1);
@@ -509,7 +509,7 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
   const int held_point = Scene::kNumFixedPoints + 5;
   std::vector<char> removed(problem.costs.size(), 0);
   for (size_t k = 0; k < removed.size(); k += 7) removed[k] = 1;
-  BundleLevenbergMarquardtOptions options;
+  BundleSolverOptions options;
   options.parameter_tolerance = 1e-12;
   options.function_tolerance = 1e-12;
   BundleLevenbergMarquardt solver(options);
@@ -531,7 +531,7 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
                                       problem.parameters[k]),
               k);
   }
-  BundleLevenbergMarquardtSummary first;
+  BundleSolverSummary first;
   solver.SetFunctionTolerance(1e-2);  // an early stop, as a pruning solve
   solver.Solve(&first);
   ASSERT_TRUE(first.IsSolutionUsable()) << first.BriefReport();
@@ -543,7 +543,7 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
   }
   solver.SetPointHeld(scene.points[held_point].data(), true);
   solver.SetFunctionTolerance(1e-12);
-  BundleLevenbergMarquardtSummary second;
+  BundleSolverSummary second;
   solver.Solve(&second);
   ASSERT_TRUE(second.IsSolutionUsable()) << second.BriefReport();
   EXPECT_EQ(second.structure_seconds, 0);  // the structure was kept
@@ -574,7 +574,7 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
                                         reference_problem.parameters[k]);
     }
   }
-  BundleLevenbergMarquardtSummary expected;
+  BundleSolverSummary expected;
   reference_solver.Solve(&expected);
   ASSERT_TRUE(expected.IsSolutionUsable()) << expected.BriefReport();
   EXPECT_EQ(second.num_residual_blocks, expected.num_residual_blocks);
