@@ -13,6 +13,20 @@ std::string FormatDouble(double value) {
   return std::string(buffer, result.ptr);
 }
 
+void AppendDouble(double value, std::string* text) {
+  char buffer[64];
+  const std::to_chars_result result =
+      std::to_chars(buffer, buffer + sizeof(buffer), value);
+  text->append(buffer, result.ptr);
+}
+
+void AppendInt64(int64_t value, std::string* text) {
+  char buffer[24];
+  const std::to_chars_result result =
+      std::to_chars(buffer, buffer + sizeof(buffer), value);
+  text->append(buffer, result.ptr);
+}
+
 std::string FormatYamlFloat(double value) {
   std::string text = FormatDouble(value);
   if (!std::isfinite(value)) {

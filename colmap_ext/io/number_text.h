@@ -12,6 +12,11 @@ namespace rig_calibrator {
 // The shortest decimal text that reads back as exactly `value`
 // (std::to_chars), e.g. "312.41", "1e-05", "-0.5".
 std::string FormatDouble(double value);
+// FormatDouble(value) appended to *text, without a string of its own (a
+// correspondence file has 10^7 numbers).
+void AppendDouble(double value, std::string* text);
+// The decimal text of `value` appended to *text.
+void AppendInt64(int64_t value, std::string* text);
 
 // As FormatDouble, but always with a decimal point in the mantissa
 // ("500.0", "1.0e-05"): YAML 1.1 readers such as PyYAML (used by Kalibr) read
