@@ -643,5 +643,65 @@ TEST(SyntheticRig, RotationOnlyAndMapScale) {
   EXPECT_FALSE(options.Check(&error));
 }
 
+// map_observations_per_image keeps at most that many of each map image's
+// visible points, the points the rig observes correctly first, and leaves
+// the rig's correspondences as they are.
+TEST(SyntheticRig, MapObservationsPerImageCapsEachMapImage) {
+  SyntheticRigOptions options;
+  options.num_framesets = 12;
+  options.points_per_image = 80;
+  options.num_map_images = 6;
+  const SyntheticRig all = GenerateSyntheticRig(options);
+  options.map_observations_per_image = 100;
+  const SyntheticRig capped = GenerateSyntheticRig(options);
+  ASSERT_EQ(capped.dataset.map_images.size(), 6u);
+  ASSERT_EQ(all.dataset.map_images.size(), 6u);
+  ASSERT_EQ(capped.dataset.images.size(), all.dataset.images.size());
+  for (size_t i = 0; i < all.dataset.images.size(); ++i) {
+    EXPECT_EQ(capped.dataset.images[i].correspondences.size(),
+              all.dataset.images[i].correspondences.size());
+  }
+  std::set<int64_t> rig_points;
+  for (size_t i = 0; i < capped.dataset.images.size(); ++i) {
+    const auto& correspondences = capped.dataset.images[i].correspondences;
+    for (size_t k = 0; k < correspondences.size(); ++k) {
+      if (!capped.is_outlier[i][k]) {
+        rig_points.insert(correspondences[k].point3D_id);
+      }
+    }
+  }
+  for (size_t m = 0; m < 6; ++m) {
+    const auto& kept = capped.dataset.map_images[m].observations;
+    EXPECT_EQ(kept.size(), 100u) << m;
+    for (size_t k = 0; k < kept.size(); ++k) {
+      EXPECT_EQ(kept[k].point2D_idx, k);
+    }
+  }
+  // The first map image is at the same pose in both (the later ones are
+  // not: their poses are drawn after the pixel noise of the observations
+  // before them), so its visible points are those of the uncapped one.
+  {
+    const auto& kept = capped.dataset.map_images[0].observations;
+    const auto& visible = all.dataset.map_images[0].observations;
+    ASSERT_GT(visible.size(), 100u);
+    std::set<int64_t> visible_ids;
+    int visible_rig_points = 0;
+    for (const MapObservation& observation : visible) {
+      visible_ids.insert(observation.point3D_id);
+      visible_rig_points += rig_points.count(observation.point3D_id);
+    }
+    int kept_rig_points = 0;
+    for (const MapObservation& observation : kept) {
+      EXPECT_EQ(visible_ids.count(observation.point3D_id), 1u);
+      kept_rig_points += rig_points.count(observation.point3D_id);
+    }
+    EXPECT_EQ(kept_rig_points, std::min(100, visible_rig_points));
+  }
+  options.map_observations_per_image = -1;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("map_observations_per_image"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rig_calibrator
