@@ -12,7 +12,7 @@
 #
 # Usage: scripts/fuzz.sh [SECONDS [TARGET...]]   (default 20 s, all targets)
 #   RIG_CALIBRATOR_FUZZ_SEED=N  libFuzzer's -seed: the same mutations on every
-#                               run (scripts/run_tests.sh sets 1), starting
+#                               run (.ci/run sets 1), starting
 #                               from the seed corpus alone (the kept inputs
 #                               differ between machines, and libFuzzer runs all
 #                               of them before it looks at the time: 165 s for
