@@ -13,7 +13,7 @@
 // axis; cameras with another model than the truth's apart). A standard
 // normal has 0.683 within 1, 0.954 within 2, RMS 1.
 //
-// RIG_CALIBRATOR_SIGMA_RUNS (default 8) sets the number of runs: the README
+// RIG_CALIBRATOR_SIGMA_RUNS (default 8) sets the number of runs: docs/accuracy.md
 // gives the table of 40 (`RIG_CALIBRATOR_SIGMA_RUNS=40
 // build/tests/default_options_sigma_test`). The test fails when σ is off
 // by a factor 1.5 or more over the pooled groups, the bounds of a normal
