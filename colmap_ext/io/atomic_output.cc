@@ -121,6 +121,13 @@ int RenameWithFlags(const fs::path& from, const fs::path& to,
 
 bool WriteFileAtomically(const std::string& path, const std::string& contents,
                          std::string* error) {
+  return WriteFileAtomically(path, std::vector<std::string_view>{contents},
+                             error);
+}
+
+bool WriteFileAtomically(const std::string& path,
+                         const std::vector<std::string_view>& pieces,
+                         std::string* error) {
   RemoveStaleSiblings(path);
   const fs::path temporary = TemporarySibling(path, "tmp");
   {
@@ -129,7 +136,9 @@ bool WriteFileAtomically(const std::string& path, const std::string& contents,
       *error = "cannot create " + temporary.string();
       return false;
     }
-    file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    for (const std::string_view piece : pieces) {
+      file.write(piece.data(), static_cast<std::streamsize>(piece.size()));
+    }
     file.close();
     if (!file) {
       // errno of the failed write or close, e.g. ENOSPC on a full disk.

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rig_calibrator {
@@ -13,6 +14,10 @@ namespace rig_calibrator {
 // and a rename (atomic on POSIX file systems). Temporary files of `path`
 // left by killed runs are removed first (as for folders, below).
 bool WriteFileAtomically(const std::string& path, const std::string& contents,
+                         std::string* error);
+// The same with the contents in pieces, written in order.
+bool WriteFileAtomically(const std::string& path,
+                         const std::vector<std::string_view>& pieces,
                          std::string* error);
 
 struct OutputFolderOptions {

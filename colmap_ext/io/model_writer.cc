@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <iomanip>
 #include <limits>
 #include <optional>
@@ -495,9 +496,7 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
                                    contents->notes.end());
   return WriteCalibrationSummaryJson(folder + "/" + kSummaryFile, final_summary,
                                      error) &&
-         WriteTimingsJson(folder + "/" + kTimingsFile, final_summary, error) &&
-         WriteCorrespondenceFile(folder + "/" + kCorrespondencesFile,
-                                 DatasetCorrespondences(dataset), error);
+         WriteTimingsJson(folder + "/" + kTimingsFile, final_summary, error);
 }
 
 }  // namespace
@@ -521,10 +520,35 @@ bool WriteRigOutput(const std::string& output_path,
   if (!WriteFolderAtomically(
           output_path, folder_options,
           [&](const std::string& folder, std::string* write_error) {
-            return WriteRigOutputFiles(folder, dataset, summary, &contents,
-                                       write_error) &&
-                   (!options.finish_folder ||
-                    options.finish_folder(folder, write_error));
+            // The correspondence file, the largest by far, is written on a
+            // thread of its own while the other files and the report are;
+            // the report reads it only for a model without points, and then
+            // waits for it. Errors in the order of a sequential write: the
+            // files', the correspondence file's, the report's.
+            std::string correspondence_error;
+            std::future<bool> correspondences = std::async(
+                std::launch::async, [&] {
+                  return WriteCorrespondenceFile(
+                      folder + "/" + kCorrespondencesFile,
+                      DatasetCorrespondences(dataset), &correspondence_error);
+                });
+            if (!WriteRigOutputFiles(folder, dataset, summary, &contents,
+                                     write_error)) {
+              correspondences.wait();
+              return false;
+            }
+            if (contents.rig_model.model.NumPoints3D() == 0) {
+              correspondences.wait();
+            }
+            std::string report_error;
+            const bool finished = !options.finish_folder ||
+                                  options.finish_folder(folder, &report_error);
+            if (!correspondences.get()) {
+              *write_error = correspondence_error;
+              return false;
+            }
+            if (!finished) *write_error = report_error;
+            return finished;
           },
           error)) {
     return false;

@@ -1,6 +1,7 @@
 #include "src/calibration/radial_bundle_adjuster.h"
 
 #include <ceres/ceres.h>
+#include <colmap/util/threading.h>
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -158,13 +159,21 @@ BundleSolverSummary Solve(
     group += in_group ? 1 : 0;
   }
   const ceres::CauchyLoss loss(options.loss_scale_px);
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  costs.reserve(observations.size());
-  for (const Observation& observation : observations) {
-    costs.push_back(std::make_unique<RadialRigCostFunction>(
-        observation.point2D, observation.point3D));
+  // The costs are made on all threads (10^6 allocations); the solver takes
+  // them in observation order.
+  const int64_t num_observations = static_cast<int64_t>(observations.size());
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs(num_observations);
+#pragma omp parallel for schedule(static) \
+    num_threads(colmap::GetEffectiveNumThreads(options.num_threads))
+  for (int64_t k = 0; k < num_observations; ++k) {
+    costs[k] = std::make_unique<RadialRigCostFunction>(
+        observations[k].point2D, observations[k].point3D);
+  }
+  solver.Reserve(observations.size(), 0);
+  for (int64_t k = 0; k < num_observations; ++k) {
+    const Observation& observation = observations[k];
     solver.AddResidualBlock(
-        costs.back().get(), &loss,
+        costs[k].get(), &loss,
         {parameters->cam_from_rig[observation.camera].data(),
          parameters->rig_from_world[observation.frameset].data(),
          parameters->principal_points[observation.camera].data()});

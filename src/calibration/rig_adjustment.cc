@@ -148,15 +148,39 @@ double RigAdjustment::MapRmsError() {
   return in_problem.empty() ? 0 : std::sqrt(sum / in_problem.size());
 }
 
+int RigAdjustment::NumThreads() const {
+  return options_.num_threads > 0 ? options_.num_threads
+                                  : omp_get_max_threads();
+}
+
 std::vector<RigAdjustment::ObservationError>
 RigAdjustment::EvaluateObservations() const {
   std::vector<ObservationError> errors(observations_.size());
   const int64_t num_observations = static_cast<int64_t>(observations_.size());
-  const int num_threads =
-      options_.num_threads > 0 ? options_.num_threads : omp_get_max_threads();
-#pragma omp parallel for schedule(static) num_threads(num_threads)
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int64_t k = 0; k < num_observations; ++k) {
     errors[k] = Evaluate(observations_[k]);
+  }
+  return errors;
+}
+
+std::vector<std::pair<int, RigAdjustment::ObservationError>>
+RigAdjustment::EvaluateWithSlots(
+    bool with_rig_observations,
+    const std::vector<MapObservationRef>& map_observations) const {
+  const int64_t num_rig =
+      with_rig_observations ? static_cast<int64_t>(observations_.size()) : 0;
+  const int64_t num_all =
+      num_rig + static_cast<int64_t>(map_observations.size());
+  std::vector<std::pair<int, ObservationError>> errors(num_all);
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
+  for (int64_t k = 0; k < num_all; ++k) {
+    if (k < num_rig) {
+      errors[k] = {CameraOf(observations_[k]), Evaluate(observations_[k])};
+    } else {
+      const MapObservationRef& observation = map_observations[k - num_rig];
+      errors[k] = {MapCameraSlot(observation), Evaluate(observation)};
+    }
   }
   return errors;
 }

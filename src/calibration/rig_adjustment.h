@@ -95,6 +95,12 @@ class RigAdjustment {
   // Evaluate of every rig observation, in their order, on all threads.
   std::vector<ObservationError> EvaluateObservations() const;
   ObservationError Evaluate(const MapObservationRef& observation) const;
+  // (slot, Evaluate) of every rig observation (`with_rig_observations`),
+  // then of `map_observations`, in that order, on all threads.
+  std::vector<std::pair<int, ObservationError>> EvaluateWithSlots(
+      bool with_rig_observations,
+      const std::vector<MapObservationRef>& map_observations) const;
+  int NumThreads() const;
   const MapObservation& MapObservationOf(
       const MapObservationRef& observation) const;
   // Pruning thresholds are per rig camera, then per map camera.

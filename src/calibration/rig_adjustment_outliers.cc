@@ -15,19 +15,14 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
   }
   // (slot, error) of the rig observations, then of the map observations of
   // the points being refined.
-  const std::vector<ObservationError> rig_errors = EvaluateObservations();
-  std::vector<std::pair<int, ObservationError>> errors;
-  errors.reserve(observations_.size());
+  const std::vector<MapObservationRef> map_observations =
+      MapObservationsInProblem();
+  const std::vector<std::pair<int, ObservationError>> errors =
+      EvaluateWithSlots(/*with_rig_observations=*/true, map_observations);
   std::vector<double> depths;
   depths.reserve(observations_.size());
   for (size_t k = 0; k < observations_.size(); ++k) {
-    errors.emplace_back(CameraOf(observations_[k]), rig_errors[k]);
-    if (rig_errors[k].depth > 0) depths.push_back(rig_errors[k].depth);
-  }
-  const std::vector<MapObservationRef> map_observations =
-      MapObservationsInProblem();
-  for (const MapObservationRef& observation : map_observations) {
-    errors.emplace_back(MapCameraSlot(observation), Evaluate(observation));
+    if (errors[k].second.depth > 0) depths.push_back(errors[k].second.depth);
   }
   const double max_depth =
       depths.empty() ? 0 : options_.max_depth_factor * colmap::Median(depths);
@@ -65,16 +60,13 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
 size_t RigAdjustment::RejectMapOutliers() {
   const std::vector<MapObservationRef> map_observations =
       MapObservationsOfRefinedPoints();
-  std::vector<std::pair<int, ObservationError>> errors;
-  errors.reserve(map_observations.size());
-  for (const MapObservationRef& observation : map_observations) {
-    errors.emplace_back(MapCameraSlot(observation), Evaluate(observation));
-  }
+  const std::vector<std::pair<int, ObservationError>> errors =
+      EvaluateWithSlots(/*with_rig_observations=*/false, map_observations);
   const std::vector<double> max_error_px = MaxErrorPerSlot(errors);
   size_t num_rejected = 0;
   for (size_t k = 0; k < map_observations.size(); ++k) {
-    if (!(errors[k].second.depth > 0 &&
-          errors[k].second.residual.norm() <= max_error_px[errors[k].first])) {
+    const auto& [slot, error] = errors[k];
+    if (!(error.depth > 0 && error.residual.norm() <= max_error_px[slot])) {
       map_rejected_[map_observations[k].image]
                    [map_observations[k].observation] = 1;
       ++num_rejected;
@@ -99,7 +91,9 @@ std::vector<double> RigAdjustment::MaxErrorPerSlot(
     }
   }
   std::vector<double> max_error_px(num_slots, options_.min_outlier_error_px);
-  for (size_t slot = 0; slot < num_slots; ++slot) {
+  const int num_slots_int = static_cast<int>(num_slots);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+  for (int slot = 0; slot < num_slots_int; ++slot) {
     if (components[slot].empty()) {
       continue;
     }

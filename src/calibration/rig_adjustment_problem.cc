@@ -58,19 +58,36 @@ bool RigAdjustment::Solve(double function_tolerance,
 // constant, the same residual as one made with the point fixed.
 void RigAdjustment::AddResidualBlocks(
     const std::vector<MapObservationRef>& map_observations) {
+  // The costs are made on all threads (10^6 allocations), then given to the
+  // solver in observation order.
+  const int64_t num_rig = static_cast<int64_t>(observations_.size());
+  const int64_t num_map = static_cast<int64_t>(map_observations.size());
+  map_costs_.resize(num_map);
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
+  for (int64_t k = 0; k < num_rig + num_map; ++k) {
+    if (k < num_rig) {
+      Observation& observation = observations_[k];
+      const RigImage& image = dataset_.images[observation.image];
+      const Correspondence& correspondence = CorrespondenceOf(observation);
+      observation.cost.reset(CreateRigReprojectionCost(
+          cameras_[image.camera_index].ModelId(), correspondence.point2D,
+          observation.refined_slot >= 0 ? nullptr : &correspondence.point3D));
+    } else {
+      const MapObservationRef& observation = map_observations[k - num_rig];
+      map_costs_[k - num_rig].reset(CreateRigReprojectionCost(
+          map_cameras_[dataset_.map_images[observation.image].camera_index]
+              .ModelId(),
+          MapObservationOf(observation).point2D, nullptr));
+    }
+  }
   has_fixed_points_ = false;
   num_rig_residuals_ = observations_.size();
   for (Observation& observation : observations_) {
     const RigImage& image = dataset_.images[observation.image];
-    const Correspondence& correspondence = CorrespondenceOf(observation);
     colmap::Camera& camera = cameras_[image.camera_index];
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
-    const bool refined = observation.refined_slot >= 0;
-    observation.cost.reset(
-        CreateRigReprojectionCost(camera.ModelId(), correspondence.point2D,
-                                  refined ? nullptr : &correspondence.point3D));
-    if (refined) {
+    if (observation.refined_slot >= 0) {
       observation.residual_index = solver_->AddResidualBlock(
           observation.cost.get(), loss_.get(),
           {rig_from_world, cam_from_rig, camera.ParamsData(),
@@ -82,20 +99,18 @@ void RigAdjustment::AddResidualBlocks(
           {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
   }
-  map_costs_.reserve(map_observations.size());
   map_residuals_.reserve(map_observations.size());
-  for (const MapObservationRef& observation : map_observations) {
-    const MapObservation& map_observation = MapObservationOf(observation);
+  for (int64_t k = 0; k < num_map; ++k) {
+    const MapObservationRef& observation = map_observations[k];
     colmap::Camera& camera =
         map_cameras_[dataset_.map_images[observation.image].camera_index];
-    map_costs_.emplace_back(CreateRigReprojectionCost(
-        camera.ModelId(), map_observation.point2D, nullptr));
     map_residuals_.emplace_back(
-        observation, solver_->AddResidualBlock(
-                         map_costs_.back().get(), loss_.get(),
-                         {map_cam_from_world_[observation.image].data(),
-                          identity_pose_.data(), camera.ParamsData(),
-                          RefinedPoint(map_observation.point3D_id)->data()}));
+        observation,
+        solver_->AddResidualBlock(
+            map_costs_[k].get(), loss_.get(),
+            {map_cam_from_world_[observation.image].data(),
+             identity_pose_.data(), camera.ParamsData(),
+             RefinedPoint(MapObservationOf(observation).point3D_id)->data()}));
     has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
   }
 }
