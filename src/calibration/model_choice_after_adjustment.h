@@ -67,7 +67,11 @@ struct ModelChoiceAfterAdjustmentOptions {
   // The fits and the held-out errors use at most this many of the camera's
   // inliers (a fixed random subset).
   int max_num_rows = 2500;
-  int max_num_iterations = 50;       // the full fit of a candidate
+  // Every candidate's fit stops at max_num_fit_iterations; those held out
+  // (and the one chosen) then go on to convergence, up to
+  // max_num_iterations (model_choice_after_adjustment.cc, the tolerances).
+  int max_num_fit_iterations = 20;
+  int max_num_iterations = 50;       // the converged fit of a candidate
   int max_num_fold_iterations = 10;  // a fold's refit, from the full fit
   double loss_scale_px = 1.0;        // Cauchy scale of the fits
   // A held-out squared error is truncated at max_error_px^2, so that the few
