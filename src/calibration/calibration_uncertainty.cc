@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -17,11 +18,15 @@
 #include <sstream>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/pipeline_report.h"
+#include "src/geometry/pose_jacobians.h"
 #include "src/geometry/rig_reprojection_cost.h"
+#include "src/geometry/tangent_jacobian_cost.h"
 #include "src/rig/rig_dataset.h"
+#include "src/solvers/bundle_levenberg_marquardt.h"
 
 namespace rig_calibrator {
 namespace {
@@ -50,28 +55,6 @@ PoseArray ToArray(const Rigid3d& pose) {
   return {pose.rotation.w(),   pose.rotation.x(),    pose.rotation.y(),
           pose.rotation.z(),   pose.translation.x(), pose.translation.y(),
           pose.translation.z()};
-}
-
-// dq'/dw at w = 0 for q' = Exp(w) q (w a rotation vector in the frame the
-// rotation maps to), q = (w, v): with Exp(w) = (1, w/2) to first order,
-// (0, w) q = (-w.v, q_w w + w x v), so dq'/dw = 1/2 [-v^T; q_w I - [v]x].
-Eigen::Matrix<double, 4, 3> QuaternionTangent(const double* q) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  Eigen::Matrix<double, 4, 3> tangent;
-  tangent << -x, -y, -z, w, z, -y, -z, w, x, y, -x, w;
-  return 0.5 * tangent;
-}
-
-using RowMajor2x7 = Eigen::Matrix<double, 2, 7, Eigen::RowMajor>;
-
-// The 2x6 Jacobian over (w, t) of a pose block from its 2x7 one over
-// (q, t).
-Eigen::Matrix<double, 2, 6> PoseTangentJacobian(const RowMajor2x7& jacobian,
-                                                const double* pose) {
-  Eigen::Matrix<double, 2, 6> tangent;
-  tangent.leftCols<3>() = jacobian.leftCols<4>() * QuaternionTangent(pose);
-  tangent.rightCols<3>() = jacobian.rightCols<3>();
-  return tangent;
 }
 
 // The indices of the intrinsic parameters the final adjustment refines
@@ -105,27 +88,20 @@ std::vector<int> FreeIntrinsics(const FinalBundleAdjustmentOptions& options,
 // camera pose (cam_from_rig, or the identity for a map image).
 struct Observation {
   int model_id = 0;
-  const double* rig_pose = nullptr;
-  const double* cam_pose = nullptr;
-  const double* params = nullptr;
+  // The values (read, never changed: non-const for the solver's
+  // interface).
+  double* rig_pose = nullptr;
+  double* cam_pose = nullptr;
+  double* params = nullptr;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector2d observed = Eigen::Vector2d::Zero();
   int point_index = -1;  // into the refined points; -1: fixed point
-  // Blocks of the reduced system (-1: held constant).
-  int rig_block = -1, cam_block = -1, intrinsics_block = -1;
-  const std::vector<int>* free_intrinsics = nullptr;
   int rig_camera = -1;  // the rig camera, -1 for a map image
+  int map_camera = -1;  // a map image's camera
   // The cluster of the between-framesets covariance: the frameset of a rig
   // image, num_framesets + m for map image m.
   int cluster = -1;
-};
-
-// One observation evaluated (UncertaintyProblem::EvaluateObservation).
-struct ObservationJacobian {
-  Eigen::Vector2d residual = Eigen::Vector2d::Zero();
-  std::vector<std::pair<int, Eigen::MatrixXd>> entries;
-  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> j_point;
-  std::vector<double> j_intrinsics;  // scratch: over all the model's params
+  size_t residual = 0;  // its residual block in the solver
 };
 
 // A parameter block of the reduced system: O (nuisance: rig poses, map
@@ -133,77 +109,6 @@ struct ObservationJacobian {
 struct Block {
   int offset = 0;
   int dim = 0;
-};
-
-// What a refined point couples: its 3x3 information and, per reduced block
-// it is observed through, the 3 x dim cross term.
-struct PointTerms {
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  std::vector<std::pair<int, Eigen::MatrixXd>> cross;
-  Eigen::Matrix3d pseudo_inverse = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-
-  Eigen::MatrixXd& Cross(int block, int dim) {
-    for (auto& [b, matrix] : cross) {
-      if (b == block) return matrix;
-    }
-    cross.emplace_back(block, Eigen::MatrixXd::Zero(3, dim));
-    return cross.back().second;
-  }
-};
-
-// The symmetric reduced system as dense blocks (upper triangle, b1 <= b2).
-class BlockMatrix {
- public:
-  explicit BlockMatrix(const std::vector<Block>& blocks) : blocks_(blocks) {}
-
-  void Add(int b1, int b2, const Eigen::MatrixXd& value) {
-    if (b1 > b2) {
-      Add(b2, b1, value.transpose());
-      return;
-    }
-    const uint64_t key = static_cast<uint64_t>(b1) * blocks_.size() + b2;
-    auto it = entries_.find(key);
-    if (it == entries_.end()) {
-      it = entries_
-               .emplace(key,
-                        Eigen::MatrixXd::Zero(blocks_[b1].dim, blocks_[b2].dim))
-               .first;
-    }
-    it->second += value;
-  }
-
-  // Adds every block of `other` (over the same blocks).
-  void AddAll(const BlockMatrix& other) {
-    for (const auto& [key, value] : other.entries_) {
-      auto it = entries_.find(key);
-      if (it == entries_.end()) {
-        entries_.emplace(key, value);
-      } else {
-        it->second += value;
-      }
-    }
-  }
-
-  // The stored block (b1 <= b2), or null.
-  const Eigen::MatrixXd* Get(int b1, int b2) const {
-    const auto it =
-        entries_.find(static_cast<uint64_t>(b1) * blocks_.size() + b2);
-    return it == entries_.end() ? nullptr : &it->second;
-  }
-
-  // Calls f(b1, b2, block) for every stored block (b1 <= b2).
-  template <typename F>
-  void ForEach(F f) const {
-    for (const auto& [key, value] : entries_) {
-      f(static_cast<int>(key / blocks_.size()),
-        static_cast<int>(key % blocks_.size()), value);
-    }
-  }
-
- private:
-  const std::vector<Block>& blocks_;
-  std::unordered_map<uint64_t, Eigen::MatrixXd> entries_;
 };
 
 // The pseudo-inverse of a symmetric positive semi-definite matrix through
@@ -235,22 +140,6 @@ Eigen::MatrixXd ScaledPseudoInverse(const Eigen::MatrixXd& matrix,
   return scale.asDiagonal() * inverse * scale.asDiagonal();
 }
 
-Eigen::Matrix3d PointPseudoInverse(const Eigen::Matrix3d& information,
-                                   int* rank) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(information);
-  const double max_eigenvalue = eigen.eigenvalues().maxCoeff();
-  Eigen::Matrix3d inverse = Eigen::Matrix3d::Zero();
-  *rank = 0;
-  for (int k = 0; k < 3; ++k) {
-    if (eigen.eigenvalues()(k) > 1e-12 * max_eigenvalue) {
-      const Eigen::Vector3d direction = eigen.eigenvectors().col(k);
-      inverse += direction * direction.transpose() / eigen.eigenvalues()(k);
-      ++*rank;
-    }
-  }
-  return inverse;
-}
-
 // d(centre)/d(w, t) of a pose x_from_world with centre c = -R^T t, for
 // R' = Exp(w) R, t' = t + dt: dc = -R^T [t]x w - R^T dt.
 Eigen::Matrix<double, 3, 6> CenterJacobian(const Rigid3d& pose) {
@@ -260,6 +149,13 @@ Eigen::Matrix<double, 3, 6> CenterJacobian(const Rigid3d& pose) {
       -rotation_t * colmap::CrossProductMatrix(pose.translation);
   jacobian.rightCols<3>() = -rotation_t;
   return jacobian;
+}
+
+// The reduced system is in the solver's tangent coordinates: a pose's
+// (d, t) of RigPoseManifold, R' = Exp(2 d) R. The rotation vector w
+// reported is 2 d: per pose coordinate, d(w, t)/d(d, t).
+Eigen::Matrix<double, 6, 1> RotationVectorPerTangent() {
+  return (Eigen::Matrix<double, 6, 1>() << 2, 2, 2, 1, 1, 1).finished();
 }
 
 double Median(std::vector<double> values) {
@@ -292,13 +188,9 @@ class UncertaintyProblem {
   void CollectObservations();
   int AddBlock(int dim, std::vector<int>* slot, int index);
   void AssignBlocks();
-  bool Accumulate();
-  struct AccumulationChunk;
-  bool EvaluateObservation(const Observation& observation,
-                           ObservationJacobian* out) const;
-  void AccumulateObservation(const Observation& observation, PointTerms* point,
-                             AccumulationChunk* chunk) const;
-  void EliminatePoint(PointTerms* point, AccumulationChunk* chunk) const;
+  bool BuildReducedSystem(std::string* error);
+  void AddParameterBlocks();
+  void GatherResidualStatistics();
   int NumThreads() const;
   void AddGaugePriors();
   bool Marginalize(CalibrationUncertainty* result);
@@ -321,23 +213,34 @@ class UncertaintyProblem {
   int undetermined_map_image_ = -1;
   PoseArray identity_ = {1, 0, 0, 0, 0, 0, 0};
   std::vector<std::vector<int>> free_intrinsics_;  // per rig camera
-  std::vector<int> all_map_intrinsics_;            // 0..n-1 of a map camera
   std::vector<std::vector<int>> map_free_intrinsics_;
+  // The intrinsics of the rig cameras and of the map cameras, copied: the
+  // solver takes non-const values.
+  std::vector<std::vector<double>> params_, map_params_;
   std::vector<Observation> observations_;
   std::vector<int64_t> point_ids_;  // refined points in the problem
   std::unordered_map<int64_t, int> point_index_;
-  std::vector<PointTerms> points_;
+  std::vector<Eigen::Vector3d> points_;  // positions of the refined points
   int num_rig_observations_ = 0, num_map_observations_ = 0;
   bool has_fixed_points_ = false;
   bool free_gauge_ = false;
 
-  // Reduced blocks and, per parameter owner, its block (-1: none).
+  // Reduced blocks and, per parameter owner, its block (-1: none); S's
+  // layout (AddParameterBlocks).
   std::vector<Block> blocks_;
   std::vector<int> rig_pose_block_, map_pose_block_, map_intrinsics_block_,
       intrinsics_block_, extrinsics_block_;
   int num_o_ = 0, num_c_ = 0;  // scalar dimensions of O and C
   int num_o_blocks_ = 0;       // blocks [0, num_o_blocks_) are O
-  std::unique_ptr<BlockMatrix> reduced_;
+  // The final adjustment's problem over observations_ and its reduced
+  // system (BuildReducedSystem): the points eliminated, S over O and C.
+  RigPoseManifold pose_manifold_;
+  std::vector<std::unique_ptr<ceres::SubsetManifold>> intrinsics_manifolds_;
+  std::vector<std::unique_ptr<ceres::CostFunction>> residual_costs_;
+  std::unique_ptr<BundleLevenbergMarquardt> solver_;
+  // S (both triangles), with the gauge priors once AddGaugePriors added
+  // them.
+  Eigen::SparseMatrix<double> information_;
 
   double sum_squared_ = 0, sum_meat_ = 0, sum_bread_ = 0;
   int64_t num_residuals_ = 0, num_parameters_ = 0;
@@ -389,6 +292,7 @@ void UncertaintyProblem::CollectObservations() {
   for (size_t c = 0; c < calibration_.cameras.size(); ++c) {
     free_intrinsics_.push_back(FreeIntrinsics(
         options_, dataset_.cameras[c].refinement, calibration_.cameras[c]));
+    params_.push_back(calibration_.cameras[c].Params());
   }
   const auto point_index = [&](int64_t point3D_id) {
     const auto [it, inserted] =
@@ -412,10 +316,9 @@ void UncertaintyProblem::CollectObservations() {
       observation.model_id = calibration_.cameras[c].ModelId();
       observation.rig_pose = rig_from_world_[image.frameset_index].data();
       observation.cam_pose = cam_from_rig_[c].data();
-      observation.params = calibration_.cameras[c].ParamsData();
+      observation.params = params_[c].data();
       observation.observed = correspondence.point2D;
       observation.rig_camera = c;
-      observation.free_intrinsics = &free_intrinsics_[c];
       const auto refined =
           calibration_.refined_points3D.find(correspondence.point3D_id);
       if (refine_points && correspondence.point3D_id >= 0 &&
@@ -433,11 +336,7 @@ void UncertaintyProblem::CollectObservations() {
         observation.point = correspondence.point3D;
         has_fixed_points_ = true;
       }
-      // Blocks are assigned later; remember the owners in the block fields.
-      observation.rig_block = image.frameset_index;
       observation.cluster = image.frameset_index;
-      observation.cam_block = c;
-      observation.intrinsics_block = c;
       observations_.push_back(observation);
       ++num_rig_observations_;
     }
@@ -455,6 +354,7 @@ void UncertaintyProblem::CollectObservations() {
       std::vector<int> all(camera.NumParams());
       for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
       map_free_intrinsics_.push_back(all);
+      map_params_.push_back(camera.Params());
     }
     for (size_t m = 0; m < dataset_.map_images.size(); ++m) {
       if (m < held_map_images_.size() && held_map_images_[m]) continue;
@@ -473,15 +373,13 @@ void UncertaintyProblem::CollectObservations() {
         observation.model_id = camera.ModelId();
         observation.rig_pose = map_cam_from_world_[m].data();
         observation.cam_pose = identity_.data();
-        observation.params = camera.ParamsData();
+        observation.params = map_params_[image.camera_index].data();
         observation.observed = map_observation.point2D;
         observation.point = refined->second;
         observation.point_index = point_index(map_observation.point3D_id);
-        observation.rig_block = static_cast<int>(m);
         observation.cluster =
             static_cast<int>(rig_from_world_.size() + m);
-        observation.intrinsics_block = image.camera_index;
-        observation.free_intrinsics = &map_free_intrinsics_[image.camera_index];
+        observation.map_camera = image.camera_index;
         observations_.push_back(observation);
         ++num_map_observations_;
         has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
@@ -490,9 +388,8 @@ void UncertaintyProblem::CollectObservations() {
   }
   free_gauge_ =
       refine_points && options_.refine_rig_poses && !has_fixed_points_;
-  points_.resize(point_ids_.size());
-  for (size_t p = 0; p < point_ids_.size(); ++p) {
-    points_[p].position = calibration_.refined_points3D.at(point_ids_[p]);
+  for (const int64_t point3D_id : point_ids_) {
+    points_.push_back(calibration_.refined_points3D.at(point3D_id));
   }
 }
 
@@ -505,9 +402,8 @@ int UncertaintyProblem::AddBlock(int dim, std::vector<int>* slot, int index) {
 }
 
 // Gives every varying parameter owner with an observation a block: O first
-// (rig poses, map poses, map intrinsics), then C (per rig camera its
-// intrinsics, then its cam_from_rig), and turns the owner indices that
-// CollectObservations left in the observations into block ids.
+// (rig poses, map poses and map intrinsics, in the observations' order),
+// then C (per rig camera its intrinsics, then its cam_from_rig).
 void UncertaintyProblem::AssignBlocks() {
   const int num_cameras = static_cast<int>(calibration_.cameras.size());
   rig_pose_block_.assign(rig_from_world_.size(), -1);
@@ -516,27 +412,20 @@ void UncertaintyProblem::AssignBlocks() {
   intrinsics_block_.assign(num_cameras, -1);
   extrinsics_block_.assign(num_cameras, -1);
   std::vector<char> camera_observed(num_cameras, 0);
-  for (Observation& observation : observations_) {
+  const int num_framesets = static_cast<int>(rig_from_world_.size());
+  for (const Observation& observation : observations_) {
     if (observation.rig_camera >= 0) {
       if (options_.refine_rig_poses) {
-        observation.rig_block =
-            AddBlock(6, &rig_pose_block_, observation.rig_block);
-      } else {
-        observation.rig_block = -1;
+        AddBlock(6, &rig_pose_block_, observation.cluster);
       }
       camera_observed[observation.rig_camera] = 1;
-    } else {
-      const int map_camera = observation.intrinsics_block;
-      observation.rig_block =
-          options_.refine_map
-              ? AddBlock(6, &map_pose_block_, observation.rig_block)
-              : -1;
-      observation.intrinsics_block =
-          options_.refine_map && options_.refine_map_intrinsics
-              ? AddBlock(
-                    static_cast<int>(map_free_intrinsics_[map_camera].size()),
-                    &map_intrinsics_block_, map_camera)
-              : -1;
+    } else if (options_.refine_map) {
+      AddBlock(6, &map_pose_block_, observation.cluster - num_framesets);
+      if (options_.refine_map_intrinsics) {
+        const int camera = observation.map_camera;
+        AddBlock(static_cast<int>(map_free_intrinsics_[camera].size()),
+                 &map_intrinsics_block_, camera);
+      }
     }
   }
   const size_t num_o_blocks = blocks_.size();
@@ -557,12 +446,6 @@ void UncertaintyProblem::AssignBlocks() {
   }
   if (num_o_blocks == blocks_.size()) num_o_ = offset;
   num_c_ = offset - num_o_;
-  for (Observation& observation : observations_) {
-    if (observation.rig_camera < 0) continue;
-    const int c = observation.rig_camera;
-    observation.cam_block = extrinsics_block_[c];
-    observation.intrinsics_block = intrinsics_block_[c];
-  }
   distances_.assign(num_cameras, {});
 }
 
@@ -577,18 +460,6 @@ Eigen::Vector3d Transform(const double* rig_pose, const double* cam_pose,
   return apply(cam_pose, apply(rig_pose, point));
 }
 
-// What one chunk of the observations adds to the reduced system and the
-// residual statistics (Accumulate). Aligned to a cache line, so that two
-// threads' chunks never share one.
-struct alignas(64) UncertaintyProblem::AccumulationChunk {
-  std::unique_ptr<BlockMatrix> reduced;
-  double sum_squared = 0, sum_meat = 0, sum_bread = 0;
-  int64_t num_used = 0;
-  int64_t num_point_parameters = 0;            // ranks of the eliminated points
-  std::vector<std::vector<double>> distances;  // per rig camera
-  ObservationJacobian evaluated;               // scratch
-};
-
 int UncertaintyProblem::NumThreads() const {
   return options_.num_threads > 0
              ? options_.num_threads
@@ -596,182 +467,115 @@ int UncertaintyProblem::NumThreads() const {
                         static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-// The residual r = projected - observed of one observation and its Jacobian
-// over the reduced blocks it varies (`entries`: block, 2 x dim in the
-// blocks' tangent spaces) and over its point. False for a point behind its
-// camera (not an inlier of the adjustment).
-bool UncertaintyProblem::EvaluateObservation(const Observation& observation,
-                                             ObservationJacobian* out) const {
-  const ceres::CostFunction* cost = costs_.at(observation.model_id).get();
-  const int num_params = cost->parameter_block_sizes()[2];
-  RowMajor2x7 j_rig, j_cam;
-  out->j_intrinsics.resize(2 * num_params);
-  const double* parameters[4] = {observation.rig_pose, observation.cam_pose,
-                                 observation.params, observation.point.data()};
-  double* jacobians[4] = {j_rig.data(), j_cam.data(),
-                          out->j_intrinsics.data(), out->j_point.data()};
-  double projected[2];
-  if (!cost->Evaluate(parameters, projected, jacobians)) return false;
-  out->residual = Eigen::Vector2d(projected[0], projected[1]) -
-                  observation.observed;
-  std::vector<std::pair<int, Eigen::MatrixXd>>& entries = out->entries;
-  entries.clear();
-  if (observation.rig_block >= 0) {
-    entries.emplace_back(observation.rig_block,
-                         PoseTangentJacobian(j_rig, observation.rig_pose));
-  }
-  if (observation.cam_block >= 0) {
-    entries.emplace_back(observation.cam_block,
-                         PoseTangentJacobian(j_cam, observation.cam_pose));
-  }
-  if (observation.intrinsics_block >= 0) {
-    const std::vector<int>& free = *observation.free_intrinsics;
-    Eigen::MatrixXd jacobian(2, free.size());
-    for (size_t k = 0; k < free.size(); ++k) {
-      jacobian(0, k) = out->j_intrinsics[free[k]];
-      jacobian(1, k) = out->j_intrinsics[num_params + free[k]];
-    }
-    entries.emplace_back(observation.intrinsics_block, jacobian);
-  }
-  return true;
-}
-
-// J^T J of one observation into the chunk's reduced blocks and the terms of
-// its refined point (`point`, null for a fixed one), and its residual
-// statistics (see the header).
-void UncertaintyProblem::AccumulateObservation(const Observation& observation,
-                                               PointTerms* point,
-                                               AccumulationChunk* chunk) const {
-  ObservationJacobian& evaluated = chunk->evaluated;
-  if (!EvaluateObservation(observation, &evaluated)) return;
-  ++chunk->num_used;
-  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
-  const double s = evaluated.residual.squaredNorm();
-  const double u = s / loss_b;
-  chunk->sum_squared += s;
-  chunk->sum_meat += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
-  chunk->sum_bread += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
-  if (observation.rig_camera >= 0) {
-    chunk->distances[observation.rig_camera].push_back(
-        Transform(observation.rig_pose, observation.cam_pose, observation.point)
-            .norm());
-  }
-  const std::vector<std::pair<int, Eigen::MatrixXd>>& entries =
-      evaluated.entries;
-  const Eigen::Matrix<double, 2, 3, Eigen::RowMajor>& j_point =
-      evaluated.j_point;
-  for (size_t i = 0; i < entries.size(); ++i) {
-    for (size_t j = i; j < entries.size(); ++j) {
-      chunk->reduced->Add(entries[i].first, entries[j].first,
-                          entries[i].second.transpose() * entries[j].second);
-    }
-  }
-  if (point != nullptr) {
-    point->information += j_point.transpose() * j_point;
-    for (const auto& [block, jacobian] : entries) {
-      point->Cross(block, blocks_[block].dim) += j_point.transpose() * jacobian;
-    }
-  }
-}
-
-// The Schur complement of one point: R -= W^T H_pp^+ W. A point direction
-// without information (e.g. along the ray of a point seen once) has none in
-// W either, so the pseudo-inverse is exact.
-void UncertaintyProblem::EliminatePoint(PointTerms* point,
-                                        AccumulationChunk* chunk) const {
-  int rank = 0;
-  point->pseudo_inverse = PointPseudoInverse(point->information, &rank);
-  chunk->num_point_parameters += rank;
-  for (size_t i = 0; i < point->cross.size(); ++i) {
-    const Eigen::MatrixXd left =
-        point->cross[i].second.transpose() * point->pseudo_inverse;
-    for (size_t j = i; j < point->cross.size(); ++j) {
-      chunk->reduced->Add(point->cross[i].first, point->cross[j].first,
-                          -left * point->cross[j].second);
-    }
-  }
-}
-
-// The reduced system with the points eliminated, and the residual
-// statistics. The observations are taken point by point, in kNumChunks
-// chunks of whole points (the fixed points' observations last), on all
-// threads: a point is eliminated by its chunk as soon as its observations
-// are in, and the chunks' sums are added in chunk order, so the result does
-// not depend on the thread count.
-bool UncertaintyProblem::Accumulate() {
-  constexpr size_t kNumChunks = 8;
-  // The cost functions first: the threads only read the cache.
-  for (const Observation& observation : observations_) {
-    if (CostFor(observation.model_id) == nullptr) return false;
-  }
-  // Observations by point (a stable counting sort), fixed points last.
-  const int num_points = static_cast<int>(points_.size());
-  std::vector<size_t> point_begin(num_points + 2, 0);
-  for (const Observation& observation : observations_) {
-    ++point_begin[(observation.point_index < 0 ? num_points
-                                               : observation.point_index) +
-                  1];
-  }
-  for (int p = 0; p <= num_points; ++p) point_begin[p + 1] += point_begin[p];
-  std::vector<size_t> order(observations_.size());
-  std::vector<size_t> next(point_begin.begin(), point_begin.end() - 1);
-  for (size_t o = 0; o < observations_.size(); ++o) {
-    const int p = observations_[o].point_index;
-    order[next[p < 0 ? num_points : p]++] = o;
-  }
-  // Chunks [first, end) of `order`: whole points, about equal sizes.
-  const size_t target =
-      std::max<size_t>(1, (order.size() + kNumChunks - 1) / kNumChunks);
-  std::vector<std::pair<size_t, size_t>> ranges;
-  size_t first = 0;
-  for (int p = 0; p < num_points; ++p) {
-    if (point_begin[p + 1] - first >= target) {
-      ranges.emplace_back(first, point_begin[p + 1]);
-      first = point_begin[p + 1];
-    }
-  }
-  if (point_begin[num_points] > first) {
-    ranges.emplace_back(first, point_begin[num_points]);
-  }
-  for (first = point_begin[num_points]; first < order.size(); first += target) {
-    ranges.emplace_back(first, std::min(order.size(), first + target));
-  }
-
-  std::vector<AccumulationChunk> chunks(ranges.size());
-  const int num_chunks = static_cast<int>(chunks.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
-  for (int c = 0; c < num_chunks; ++c) {
-    AccumulationChunk& chunk = chunks[c];
-    chunk.reduced = std::make_unique<BlockMatrix>(blocks_);
-    chunk.distances.assign(distances_.size(), {});
-    for (size_t k = ranges[c].first; k < ranges[c].second; ++k) {
-      const Observation& observation = observations_[order[k]];
-      const int p = observation.point_index;
-      AccumulateObservation(observation, p >= 0 ? &points_[p] : nullptr,
-                            &chunk);
-      if (p >= 0 && k + 1 == point_begin[p + 1]) {
-        EliminatePoint(&points_[p], &chunk);
+// The parameter blocks of the final adjustment that blocks_ vary, with
+// its tangent spaces (poses on RigPoseManifold, partly held intrinsics on a
+// SubsetManifold of the held ones), and the refined points in points_'
+// order. Groups (the solver's block rows): every O block on its own (group
+// b for block b), and, as in the adjustment, every rig camera's intrinsics
+// and cam_from_rig together (so an observation couples two groups, not
+// three), in that order: AssignBlocks made them consecutive blocks, so the
+// groups' columns lie where blocks_ says.
+void UncertaintyProblem::AddParameterBlocks() {
+  const auto add_intrinsics = [&](std::vector<double>* params,
+                                  const std::vector<int>& free, int group) {
+    const int num_params = static_cast<int>(params->size());
+    const ceres::Manifold* manifold = nullptr;
+    if (static_cast<int>(free.size()) < num_params) {
+      std::vector<int> held;
+      for (int i = 0; i < num_params; ++i) {
+        if (!std::binary_search(free.begin(), free.end(), i)) {
+          held.push_back(i);
+        }
       }
+      intrinsics_manifolds_.push_back(
+          std::make_unique<ceres::SubsetManifold>(num_params, held));
+      manifold = intrinsics_manifolds_.back().get();
     }
+    solver_->AddParameterBlock(params->data(), num_params, manifold, group);
+  };
+  for (size_t f = 0; f < rig_pose_block_.size(); ++f) {
+    if (rig_pose_block_[f] < 0) continue;
+    solver_->AddParameterBlock(rig_from_world_[f].data(), 7, &pose_manifold_,
+                               rig_pose_block_[f]);
   }
-  reduced_ = std::make_unique<BlockMatrix>(blocks_);
-  int64_t num_used = 0;
-  for (AccumulationChunk& chunk : chunks) {
-    reduced_->AddAll(*chunk.reduced);
-    chunk.reduced.reset();
-    sum_squared_ += chunk.sum_squared;
-    sum_meat_ += chunk.sum_meat;
-    sum_bread_ += chunk.sum_bread;
-    num_used += chunk.num_used;
-    num_parameters_ += chunk.num_point_parameters;
-    for (size_t camera = 0; camera < distances_.size(); ++camera) {
-      distances_[camera].insert(distances_[camera].end(),
-                                chunk.distances[camera].begin(),
-                                chunk.distances[camera].end());
+  for (size_t m = 0; m < map_pose_block_.size(); ++m) {
+    if (map_pose_block_[m] < 0) continue;
+    solver_->AddParameterBlock(map_cam_from_world_[m].data(), 7,
+                               &pose_manifold_, map_pose_block_[m]);
+  }
+  for (size_t k = 0; k < map_intrinsics_block_.size(); ++k) {
+    if (map_intrinsics_block_[k] < 0) continue;
+    add_intrinsics(&map_params_[k], map_free_intrinsics_[k],
+                   map_intrinsics_block_[k]);
+  }
+  int group = num_o_blocks_;
+  for (size_t c = 0; c < params_.size(); ++c) {
+    if (intrinsics_block_[c] < 0 && extrinsics_block_[c] < 0) continue;
+    if (intrinsics_block_[c] >= 0) {
+      add_intrinsics(&params_[c], free_intrinsics_[c], group);
     }
+    if (extrinsics_block_[c] >= 0) {
+      solver_->AddParameterBlock(cam_from_rig_[c].data(), 7, &pose_manifold_,
+                                 group);
+    }
+    ++group;
   }
-  num_residuals_ = 2 * num_used;
+  for (Eigen::Vector3d& point : points_) solver_->AddPoint(point.data());
+}
+
+// The final adjustment's problem over the observations, registered with the
+// own solver (bundle_levenberg_marquardt.h) whatever backend ran the
+// adjustment (Ceres' gives no reduced system), and its Gauss-Newton reduced
+// system at the result: S = J^T J with the points eliminated
+// (LinearizeGaussNewton), in information_.
+bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
+  BundleSolverOptions solver_options;
+  solver_options.num_threads = options_.num_threads;
+  solver_ = std::make_unique<BundleLevenbergMarquardt>(solver_options);
+  AddParameterBlocks();
+  solver_->Reserve(observations_.size(), points_.size());
+  residual_costs_.reserve(observations_.size());
+  std::vector<double*> parameters;
+  for (Observation& observation : observations_) {
+    const bool refined = observation.point_index >= 0;
+    residual_costs_.emplace_back(CreateRigReprojectionCost(
+        observation.model_id, observation.observed,
+        refined ? nullptr : &observation.point));
+    if (residual_costs_.back() == nullptr) {
+      *error = "a camera model without a cost function";
+      return false;
+    }
+    parameters.assign(
+        {observation.rig_pose, observation.cam_pose, observation.params});
+    if (refined) parameters.push_back(points_[observation.point_index].data());
+    observation.residual = solver_->AddResidualBlock(
+        residual_costs_.back().get(), nullptr, parameters);
+  }
+  if (!solver_->LinearizeGaussNewton(error)) return false;
+  information_ = solver_->ReducedMatrix().selfadjointView<Eigen::Upper>();
+  num_parameters_ += solver_->NumDeterminedPointParameters();
   return true;
+}
+
+// The residual statistics of the header (sum |r|^2, and the sums of
+// rho'(s)^2 s / 2 and rho'(s) + s rho''(s) of the Cauchy loss) and, per rig
+// camera, the distances of its observed points.
+void UncertaintyProblem::GatherResidualStatistics() {
+  const double loss_b = options_.loss_scale_px * options_.loss_scale_px;
+  for (const Observation& observation : observations_) {
+    const double s = solver_->Residual(observation.residual).squaredNorm();
+    const double u = s / loss_b;
+    sum_squared_ += s;
+    sum_meat_ += s / 2 / ((1 + u) * (1 + u));  // rho'^2 s / 2
+    sum_bread_ += 1 / ((1 + u) * (1 + u));     // rho' + s rho''
+    if (observation.rig_camera >= 0) {
+      distances_[observation.rig_camera].push_back(
+          Transform(observation.rig_pose, observation.cam_pose,
+                    observation.point)
+              .norm());
+    }
+  }
+  num_residuals_ = 2 * static_cast<int64_t>(observations_.size());
 }
 
 // With a free gauge, priors that fix it (any do, see the header): the first
@@ -804,26 +608,33 @@ void UncertaintyProblem::AddGaugePriors() {
     }
   }
   if (first < 0) return;
-  const int first_block = rig_pose_block_[first];
-  const Eigen::MatrixXd* diagonal = reduced_->Get(first_block, first_block);
-  const double weight =
-      diagonal != nullptr && diagonal->trace() > 0 ? diagonal->trace() / 6 : 1;
-  reduced_->Add(first_block, first_block,
-                weight * Eigen::MatrixXd::Identity(6, 6));
-  if (scale_direction_c_.norm() > 0) {
-    // lambda n n^T / |n|^2 over the cam_from_rig blocks.
-    const double norm2 = scale_direction_c_.squaredNorm();
-    for (size_t c1 = 0; c1 < extrinsics_block_.size(); ++c1) {
-      for (size_t c2 = c1; c2 < extrinsics_block_.size(); ++c2) {
-        const int b1 = extrinsics_block_[c1], b2 = extrinsics_block_[c2];
-        if (b1 < 0 || b2 < 0) continue;
-        const Eigen::VectorXd n1 =
-            scale_direction_c_.segment(blocks_[b1].offset - num_o_, 6);
-        const Eigen::VectorXd n2 =
-            scale_direction_c_.segment(blocks_[b2].offset - num_o_, 6);
-        reduced_->Add(b1, b2, weight * n1 * n2.transpose() / norm2);
+  // The priors as triplets: `prior` on the rows and columns [offset,
+  // offset + its size).
+  std::vector<Eigen::Triplet<double>> triplets;
+  const auto add = [&](int offset, const Eigen::MatrixXd& prior) {
+    for (int i = 0; i < prior.rows(); ++i) {
+      for (int j = 0; j < prior.cols(); ++j) {
+        triplets.emplace_back(offset + i, offset + j, prior(i, j));
       }
     }
+  };
+  // The weight: the mean information of the first rig pose's (w, t); its
+  // prior lambda I over (w, t) is lambda T^2 over the solver's (d, t), T =
+  // RotationVectorPerTangent().
+  const int first_offset = blocks_[rig_pose_block_[first]].offset;
+  const Eigen::Matrix<double, 6, 1> t_squared =
+      RotationVectorPerTangent().array().square();
+  const double trace =
+      (information_.diagonal().segment<6>(first_offset).array() /
+       t_squared.array())
+          .sum();
+  const double weight = trace > 0 ? trace / 6 : 1;
+  add(first_offset, weight * Eigen::MatrixXd(t_squared.asDiagonal()));
+  if (scale_direction_c_.norm() > 0) {
+    // lambda n n^T / |n|^2 over C (n_C is zero outside the cam_from_rig
+    // translations).
+    add(num_o_, weight * scale_direction_c_ * scale_direction_c_.transpose() /
+                    scale_direction_c_.squaredNorm());
   } else if (farthest >= 0) {
     // Scaling about the first rig centre c*: t_Q of rig pose Q moves by
     // -R_Q (c_Q - c*).
@@ -833,39 +644,21 @@ void UncertaintyProblem::AddGaugePriors() {
         -(pose.RotationMatrix() *
           (pose.Center() - calibration_.rig_from_world[first]->Center()))
              .normalized();
-    const int block = rig_pose_block_[farthest];
-    reduced_->Add(block, block, weight * direction * direction.transpose());
+    add(blocks_[rig_pose_block_[farthest]].offset,
+        weight * direction * direction.transpose());
   }
+  Eigen::SparseMatrix<double> priors(information_.rows(), information_.cols());
+  priors.setFromTriplets(triplets.begin(), triplets.end());
+  information_ += priors;
 }
 
 // Covariance over C of the reduced system: S_C = R_CC - R_CO R_OO^-1 R_OC,
 // R_OO by a sparse LDL^T factorization of its Jacobi-scaled form.
 bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
-  std::vector<Eigen::Triplet<double>> triplets;
-  Eigen::VectorXd diagonal_o = Eigen::VectorXd::Zero(num_o_);
-  r_oc_ = Eigen::MatrixXd::Zero(num_o_, num_c_);
-  Eigen::MatrixXd r_cc = Eigen::MatrixXd::Zero(num_c_, num_c_);
-  reduced_->ForEach([&](int b1, int b2, const Eigen::MatrixXd& value) {
-    const int o1 = blocks_[b1].offset, o2 = blocks_[b2].offset;
-    if (b2 < num_o_blocks_) {
-      for (int i = 0; i < value.rows(); ++i) {
-        for (int j = 0; j < value.cols(); ++j) {
-          triplets.emplace_back(o1 + i, o2 + j, value(i, j));
-          if (b1 != b2) triplets.emplace_back(o2 + j, o1 + i, value(i, j));
-        }
-      }
-      if (b1 == b2) diagonal_o.segment(o1, value.rows()) = value.diagonal();
-    } else if (b1 < num_o_blocks_) {
-      r_oc_.block(o1, o2 - num_o_, value.rows(), value.cols()) = value;
-    } else {
-      r_cc.block(o1 - num_o_, o2 - num_o_, value.rows(), value.cols()) = value;
-      if (b1 != b2) {
-        r_cc.block(o2 - num_o_, o1 - num_o_, value.cols(), value.rows()) =
-            value.transpose();
-      }
-    }
-  });
-  Eigen::MatrixXd schur = r_cc;
+  const Eigen::VectorXd diagonal_o = information_.diagonal().head(num_o_);
+  r_oc_ = information_.topRightCorner(num_o_, num_c_).toDense();
+  Eigen::MatrixXd schur =
+      information_.bottomRightCorner(num_c_, num_c_).toDense();
   if (num_o_ > 0) {
     if (!(diagonal_o.minCoeff() > 0)) {
       result->message =
@@ -874,12 +667,9 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
       return false;
     }
     scale_o_ = diagonal_o.cwiseSqrt().cwiseInverse();
-    for (Eigen::Triplet<double>& t : triplets) {
-      t = Eigen::Triplet<double>(
-          t.row(), t.col(), t.value() * scale_o_(t.row()) * scale_o_(t.col()));
-    }
-    Eigen::SparseMatrix<double> r_oo(num_o_, num_o_);
-    r_oo.setFromTriplets(triplets.begin(), triplets.end());
+    const Eigen::SparseMatrix<double> r_oo =
+        scale_o_.asDiagonal() * information_.topLeftCorner(num_o_, num_o_) *
+        scale_o_.asDiagonal();
     ldlt_o_.compute(r_oo);
     if (ldlt_o_.info() != Eigen::Success ||
         !(ldlt_o_.vectorD().minCoeff() > kMinScaledEigenvalue)) {
@@ -967,6 +757,7 @@ void UncertaintyProblem::AnchorScale() {
     for (size_t m = 0; m < map_pose_block_.size(); ++m) {
       if (map_pose_block_[m] < 0) continue;
       a_o.segment<6>(blocks_[map_pose_block_[m]].offset) =
+          RotationVectorPerTangent().asDiagonal() *
           CenterJacobian(poses[m]).transpose() * (poses[m].Center() - mean) /
           spread;
     }
@@ -982,18 +773,14 @@ void UncertaintyProblem::AnchorScale() {
     }
     if (!(spread > 0)) return;
     for (size_t p = 0; p < points_.size(); ++p) {
-      a_points[p] = (points_[p].position - mean) / spread;
+      a_points[p] = (points_[p] - mean) / spread;
     }
   }
   // Right-hand side after eliminating the points.
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(num_o_ + num_c_);
   rhs.head(num_o_) = a_o;
   for (size_t p = 0; p < points_.size(); ++p) {
-    const Eigen::Vector3d pa = points_[p].pseudo_inverse * a_points[p];
-    for (const auto& [block, cross] : points_[p].cross) {
-      rhs.segment(blocks_[block].offset, blocks_[block].dim) -=
-          cross.transpose() * pa;
-    }
+    solver_->EliminatePointVector(static_cast<int>(p), a_points[p], &rhs);
   }
   Eigen::VectorXd y_o = Eigen::VectorXd::Zero(num_o_);
   Eigen::VectorXd rhs_c = rhs.tail(num_c_);
@@ -1009,11 +796,8 @@ void UncertaintyProblem::AnchorScale() {
   double a_v = a_o.dot(v.head(num_o_));
   anchor_v_points_.assign(points_.size(), Eigen::Vector3d::Zero());
   for (size_t p = 0; p < points_.size(); ++p) {
-    Eigen::Vector3d residual = a_points[p];
-    for (const auto& [block, cross] : points_[p].cross) {
-      residual -= cross * v.segment(blocks_[block].offset, blocks_[block].dim);
-    }
-    anchor_v_points_[p] = points_[p].pseudo_inverse * residual;
+    anchor_v_points_[p] =
+        solver_->BackSubstitutePoint(static_cast<int>(p), a_points[p], v);
     a_v += a_points[p].dot(anchor_v_points_[p]);
   }
   anchor_v_ = v;
@@ -1056,19 +840,14 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
   for (int g = 0; g < num_used; ++g) {
     Eigen::VectorXd score = Eigen::VectorXd::Zero(num_o_ + num_c_);
     std::vector<std::pair<int, Eigen::Vector3d>> point_scores;
-    ObservationJacobian evaluated;
     for (const int o : by_cluster[clusters[g]]) {
       const Observation& observation = observations_[o];
-      if (!EvaluateObservation(observation, &evaluated)) continue;
-      const double u = evaluated.residual.squaredNorm() / loss_b;
-      const Eigen::Vector2d weighted = evaluated.residual / (1 + u);
-      for (const auto& [block, jacobian] : evaluated.entries) {
-        score.segment(blocks_[block].offset, blocks_[block].dim) +=
-            jacobian.transpose() * weighted;
-      }
+      const double u =
+          solver_->Residual(observation.residual).squaredNorm() / loss_b;
+      const Eigen::Vector3d point_score =
+          solver_->AddGradient(observation.residual, 1 / (1 + u), &score);
       if (observation.point_index >= 0) {
-        point_scores.emplace_back(observation.point_index,
-                                  evaluated.j_point.transpose() * weighted);
+        point_scores.emplace_back(observation.point_index, point_score);
       }
     }
     double anchor = anchored ? anchor_v_.dot(score) : 0;
@@ -1082,11 +861,7 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
       for (; k < point_scores.size() && point_scores[k].first == p; ++k) {
         point_score += point_scores[k].second;
       }
-      const Eigen::Vector3d solved = points_[p].pseudo_inverse * point_score;
-      for (const auto& [block, cross] : points_[p].cross) {
-        reduced.segment(blocks_[block].offset, blocks_[block].dim) -=
-            cross.transpose() * solved;
-      }
+      solver_->EliminatePointVector(p, point_score, &reduced);
       if (anchored) anchor += anchor_v_points_[p].dot(point_score);
     }
     Eigen::VectorXd rhs_c = reduced.tail(num_c_);
@@ -1116,13 +891,13 @@ void UncertaintyProblem::FillProjection(int camera_index,
                                       static_cast<double>(camera.Height()) /
                                       camera.Width())));
   projection.stddev_px.assign(projection.cols * projection.rows, kNaN);
-  ceres::CostFunction* cost = CostFor(camera.ModelId());
+  const auto* cost =
+      dynamic_cast<const TangentJacobianCost*>(CostFor(camera.ModelId()));
   const int num_params = static_cast<int>(camera.NumParams());
   const Rigid3d& cam_from_rig = calibration_.cam_from_rig[camera_index];
   const Rigid3d rig_from_cam = cam_from_rig.Inverse();
   const PoseArray& cam_pose = cam_from_rig_[camera_index];
-  RowMajor2x7 j_rig, j_cam;
-  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> j_point;
+  Eigen::Matrix<double, 2, 6, Eigen::RowMajor> j_cam;  // over (d, t)
   std::vector<double> j_intrinsics(2 * num_params);
   std::vector<double> values;
   for (int row = 0; row < projection.rows; ++row) {
@@ -1141,16 +916,18 @@ void UncertaintyProblem::FillProjection(int camera_index,
           (projection.depth * normalized.homogeneous().normalized());
       const double* parameters[4] = {identity_.data(), cam_pose.data(),
                                      camera.ParamsData(), point_in_rig.data()};
-      double* jacobians[4] = {j_rig.data(), j_cam.data(), j_intrinsics.data(),
-                              j_point.data()};
+      double* jacobians[4] = {nullptr, j_cam.data(), j_intrinsics.data(),
+                              nullptr};
       double residual[2];
-      if (!cost->Evaluate(parameters, residual, jacobians)) continue;
+      if (!cost->EvaluateTangent(parameters, residual, jacobians)) continue;
       Eigen::MatrixXd jacobian(2, num_params + 6);
       for (int k = 0; k < num_params; ++k) {
         jacobian(0, k) = j_intrinsics[k];
         jacobian(1, k) = j_intrinsics[num_params + k];
       }
-      jacobian.rightCols<6>() = PoseTangentJacobian(j_cam, cam_pose.data());
+      // Over (w, t), w = 2 d.
+      jacobian.rightCols<6>() =
+          j_cam * RotationVectorPerTangent().cwiseInverse().asDiagonal();
       // The larger of the two estimates (see the header), each in its
       // worst direction.
       double stddev = 0;
@@ -1193,6 +970,9 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
         static_cast<int>(calibration_.cameras[c].NumParams());
     // The C index of every entry of [params, w, t] (-1: held).
     std::vector<int> index(num_params + 6, -1);
+    // d[params, w, t] / d(C coordinates) per entry (see
+    // RotationVectorPerTangent).
+    Eigen::VectorXd scale = Eigen::VectorXd::Ones(num_params + 6);
     if (intrinsics_block_[c] >= 0) {
       const int offset = blocks_[intrinsics_block_[c]].offset - num_o_;
       for (size_t k = 0; k < free_intrinsics_[c].size(); ++k) {
@@ -1202,6 +982,7 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
     if (extrinsics_block_[c] >= 0) {
       const int offset = blocks_[extrinsics_block_[c]].offset - num_o_;
       for (int k = 0; k < 6; ++k) index[num_params + k] = offset + k;
+      scale.tail<6>() = RotationVectorPerTangent();
     }
     const int size = num_params + 6;
     camera.covariance = Eigen::MatrixXd::Zero(size, size);
@@ -1216,10 +997,11 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
       camera.determined = camera.determined && !undetermined[i];
       for (int j = 0; j < size; ++j) {
         if (index[j] < 0) continue;
-        camera.covariance(i, j) = variance * covariance_c_(index[i], index[j]);
+        camera.covariance(i, j) = variance * scale(i) * scale(j) *
+                                  covariance_c_(index[i], index[j]);
         if (between) {
           camera.between_framesets_covariance(i, j) =
-              cluster_covariance_c_(index[i], index[j]);
+              scale(i) * scale(j) * cluster_covariance_c_(index[i], index[j]);
         }
       }
     }
@@ -1328,10 +1110,8 @@ bool UncertaintyProblem::Run(const UncertaintyOptions& options,
     return false;
   }
   AssignBlocks();
-  if (!Accumulate()) {
-    result->message = "a camera model without a cost function";
-    return false;
-  }
+  if (!BuildReducedSystem(&result->message)) return false;
+  GatherResidualStatistics();
   num_parameters_ += num_o_ + num_c_ - (free_gauge_ ? 7 : 0);
   result->num_residuals = num_residuals_;
   result->num_parameters = num_parameters_;

@@ -26,6 +26,19 @@
 // sparse Cholesky factorization of the reduced system), leaving the
 // covariance of the intrinsics and cam_from_rig of the rig cameras.
 //
+// The reduced system is the solver's. The adjustment's problem (its cost
+// functions over the observations above, its parameter blocks and
+// manifolds, its refined points) is registered with the own Levenberg-
+// Marquardt solver, whichever backend ran the adjustment, and its
+// Gauss-Newton reduced system taken at the result
+// (BundleLevenbergMarquardt::LinearizeGaussNewton: J^T J without loss or
+// damping, the points eliminated by the step's own code, V_p^+ for a point
+// without information along a direction); the anchoring and the
+// between-framesets scores move point-side vectors with its
+// EliminatePointVector and BackSubstitutePoint. Its pose coordinates are
+// RigPoseManifold's (d, t), R' = Exp(2 d) R: the covariance is computed in
+// them and reported in (w, t), w = 2 d.
+//
 // Gauge. The reference camera's cam_from_rig is the identity and has no
 // uncertainty. Fixed map points (refine_points off, or points seen once) or
 // fixed map images (refine_map off) fix the world frame and scale, and the

@@ -1,10 +1,12 @@
 #include "src/solvers/bundle_levenberg_marquardt.h"
 
 #include <glog/logging.h>
+#include <sys/mman.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
@@ -12,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <thread>
 #include <unordered_map>
@@ -96,12 +99,31 @@ void CountingSort(int range, Key key, std::vector<T>* items,
 // (hundreds of MB at 10^6 residuals) are written in full by the first
 // (parallel) evaluation of every solve, so zeroing them first would touch
 // every page once more, on one thread (500 framesets x 10 cameras: the
-// structure of the first solve 3.1 -> 1.2 s).
+// structure of the first solve 3.1 -> 1.2 s). From 8 MB on it asks for
+// 2 MB pages (transparent huge pages, which Linux gives on request by
+// default): the first touch of each 4 KB page is a page fault, and those
+// were most of a single linearization (LinearizeGaussNewton, 360 000
+// residuals: its evaluation 0.37 -> 0.15 s). Smaller arrays would waste
+// much of a 2 MB page.
 class UninitializedArray {
  public:
   void Resize(size_t size) {
     if (size != size_ || values_ == nullptr) {
-      values_.reset(new double[std::max<size_t>(1, size)]);
+      constexpr size_t kHugePage = size_t{2} << 20;
+      const size_t bytes = std::max<size_t>(1, size) * sizeof(double);
+      if (bytes < 4 * kHugePage) {
+        values_.reset(static_cast<double*>(std::malloc(bytes)));
+      } else {
+        const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+        values_.reset(
+            static_cast<double*>(std::aligned_alloc(kHugePage, rounded)));
+#ifdef MADV_HUGEPAGE
+        if (values_ != nullptr) {
+          madvise(values_.get(), rounded, MADV_HUGEPAGE);  // a hint
+        }
+#endif
+      }
+      CHECK(values_ != nullptr) << "out of memory";
       size_ = size;
     }
   }
@@ -111,7 +133,10 @@ class UninitializedArray {
   const double& operator[](size_t i) const { return values_[i]; }
 
  private:
-  std::unique_ptr<double[]> values_;
+  struct Free {
+    void operator()(double* p) const { std::free(p); }
+  };
+  std::unique_ptr<double[], Free> values_;
   size_t size_ = 0;
 };
 
@@ -129,6 +154,23 @@ void PrintIteration(int iteration, double cost, double cost_change,
       "%4d % 8e   % 3.2e   % 3.2e   % 3.2e   % 3.2e  % 3.2e  %8.2e   %8.2e\n",
       iteration, cost, cost_change, gradient_max_norm, step_norm, ratio, radius,
       iteration_seconds, total_seconds);
+}
+
+// The pseudo-inverse of a point's V_p (symmetric positive semi-definite)
+// and its rank: eigenvalues below 1e-12 of the largest count as 0.
+Eigen::Matrix3d PointPseudoInverse(const Eigen::Matrix3d& v, int* rank) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(v);
+  const double max_eigenvalue = eigen.eigenvalues().maxCoeff();
+  Eigen::Matrix3d inverse = Eigen::Matrix3d::Zero();
+  *rank = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (eigen.eigenvalues()(k) > 1e-12 * max_eigenvalue) {
+      const Eigen::Vector3d direction = eigen.eigenvectors().col(k);
+      inverse += direction * direction.transpose() / eigen.eigenvalues()(k);
+      ++*rank;
+    }
+  }
+  return inverse;
 }
 
 }  // namespace
@@ -250,6 +292,9 @@ struct BundleLevenbergMarquardt::Impl {
   std::vector<size_t> reduced_value_source;  // CSC entry -> pair value
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>
       cholesky;
+  // Its symbolic factorization of `reduced`'s pattern is done (by Solve:
+  // LinearizeGaussNewton factorizes nothing).
+  bool pattern_analyzed = false;
 
   // Linearization at the current estimate.
   std::vector<double> residual_values;  // corrected, 2 per residual
@@ -286,6 +331,11 @@ struct BundleLevenbergMarquardt::Impl {
                       const std::vector<Intervals>& intervals, int num_chunks,
                       double* out) const;
   std::vector<double> reduced_values;  // S, pair values, at each step
+  // False while LinearizeGaussNewton evaluates: rho(s) = s for every
+  // residual.
+  bool robust_loss = true;
+  // LinearizeGaussNewton: per point, the rank of V_p.
+  std::vector<int> point_rank;
 
   int NumThreads() const {
     return options.num_threads > 0
@@ -304,6 +354,19 @@ struct BundleLevenbergMarquardt::Impl {
   bool EvaluateResidual(const Residual& residual, bool linearize,
                         std::vector<double>* scratch, double* cost,
                         double* residual_out, double* jacobian_base) const;
+  // Eliminates the points (the Schur complement of the step and of
+  // LinearizeGaussNewton): with V~_p^-1 = invert(p, V_p) (kept in
+  // point_v_inverse), the pair values of
+  //   S = U - sum_p W_p^T V~_p^-1 W_p   into reduced_values,
+  //   rhs = -b_c + sum_p W_p^T V~_p^-1 b_p,
+  // chunk by chunk into the chunks' copies, added in chunk order.
+  template <typename Invert>
+  void EliminatePoints(Invert invert, Eigen::VectorXd* rhs);
+  // reduced's CSC values from reduced_values.
+  void CopyReducedValues();
+  // V~_p^-1 (right - W_p x_c), x_c the camera-side vector at `camera`.
+  Eigen::Vector3d SolvePoint(int p, Eigen::Vector3d right,
+                             const double* camera) const;
   // Forms and factorizes the reduced system at radius mu, solves for the
   // camera-side step and back-substitutes the points'. False if the
   // factorization fails.
@@ -594,11 +657,7 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   for (Eigen::Index k = 0; k < reduced.nonZeros(); ++k) {
     reduced_value_source[k] = static_cast<size_t>(reduced.valuePtr()[k]);
   }
-  cholesky.analyzePattern(reduced);
-  if (cholesky.info() != Eigen::Success) {
-    *error = "the symbolic analysis of the reduced system failed";
-    return false;
-  }
+  pattern_analyzed = false;
 
   // Point chunks: consecutive points of about equal residual counts.
   chunks.clear();
@@ -745,7 +804,9 @@ bool BundleLevenbergMarquardt::Impl::EvaluateResidual(
   }
   const double sq_norm = r[0] * r[0] + r[1] * r[1];
   double rho[3] = {sq_norm, 1, 0};
-  if (residual.loss != nullptr) residual.loss->Evaluate(sq_norm, rho);
+  if (residual.loss != nullptr && robust_loss) {
+    residual.loss->Evaluate(sq_norm, rho);
+  }
   *cost += 0.5 * rho[0];
   if (!linearize) return true;
 
@@ -966,10 +1027,9 @@ void BundleLevenbergMarquardt::Impl::SumChunkCopies(
   }
 }
 
-bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
-                                                 double* factorization_seconds,
-                                                 double* schur_seconds) {
-  const auto schur_start = std::chrono::steady_clock::now();
+template <typename Invert>
+void BundleLevenbergMarquardt::Impl::EliminatePoints(Invert invert,
+                                                     Eigen::VectorXd* rhs) {
   const int num_chunks = static_cast<int>(chunks.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
   for (int c = 0; c < num_chunks; ++c) {
@@ -985,13 +1045,9 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
     for (int p = chunk.first_point; p < chunk.end_point; ++p) {
       if (point_held[p]) continue;  // V_p, W_p and b_p are zero: no term
       const PointStructure structure = StructureOf(p);
-      Eigen::Matrix3d v = Eigen::Map<const Eigen::Matrix3d>(&point_v[9 * p]);
-      for (int i = 0; i < 3; ++i) {
-        v(i, i) += std::clamp(v(i, i), kMinDiagonal, kMaxDiagonal) / mu;
-      }
-      // V~ is symmetric positive definite (the LM diagonal is > 0).
       Eigen::Map<Eigen::Matrix3d> v_inverse(&point_v_inverse[9 * p]);
-      v_inverse = v.llt().solve(Eigen::Matrix3d::Identity());
+      v_inverse =
+          invert(p, Eigen::Map<const Eigen::Matrix3d>(&point_v[9 * p]));
       const Eigen::Vector3d vb =
           v_inverse * Eigen::Map<const Eigen::Vector3d>(&point_b[3 * p]);
       const int n = structure.num_groups;
@@ -1027,14 +1083,55 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
       }
     }
   }
-  // S = U + D / mu + the chunks' parts; rhs = -b_c + theirs; chunk order.
-  std::vector<double>& s = reduced_values;
-  SumChunkCopies(u_raw.data(), point_chunk_intervals, num_chunks, s.data());
-  Eigen::VectorXd rhs =
-      -Eigen::Map<const Eigen::VectorXd>(b_camera.data(), reduced_size);
+  // S = U + the chunks' parts; rhs = -b_c + theirs; chunk order.
+  SumChunkCopies(u_raw.data(), point_chunk_intervals, num_chunks,
+                 reduced_values.data());
+  *rhs = -Eigen::Map<const Eigen::VectorXd>(b_camera.data(), reduced_size);
   for (int c = 0; c < num_chunks; ++c) {
-    for (int k = 0; k < reduced_size; ++k) rhs[k] += chunk_vectors[c][k];
+    for (int k = 0; k < reduced_size; ++k) (*rhs)[k] += chunk_vectors[c][k];
   }
+}
+
+void BundleLevenbergMarquardt::Impl::CopyReducedValues() {
+  const std::vector<double>& s = reduced_values;
+  double* values = reduced.valuePtr();
+  const int64_t num_values = static_cast<int64_t>(reduced_value_source.size());
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
+  for (int64_t k = 0; k < num_values; ++k) {
+    values[k] = s[reduced_value_source[k]];
+  }
+}
+
+Eigen::Vector3d BundleLevenbergMarquardt::Impl::SolvePoint(
+    int p, Eigen::Vector3d right, const double* camera) const {
+  const PointStructure structure = StructureOf(p);
+  for (int i = 0; i < structure.num_groups; ++i) {
+    const Group& group = groups[structure.groups[i]];
+    Eigen::Vector3d w_delta = Eigen::Vector3d::Zero();
+    AddAB(&point_w[structure.w_offset[i]], camera + group.offset, 3,
+          group.size, 1, w_delta.data(), 1);
+    right -= w_delta;
+  }
+  return Eigen::Map<const Eigen::Matrix3d>(&point_v_inverse[9 * p]) * right;
+}
+
+bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
+                                                 double* factorization_seconds,
+                                                 double* schur_seconds) {
+  const auto schur_start = std::chrono::steady_clock::now();
+  // V~_p = V_p + D_p / mu, symmetric positive definite (the LM diagonal is
+  // > 0).
+  Eigen::VectorXd rhs;
+  EliminatePoints(
+      [mu](int, Eigen::Matrix3d v) -> Eigen::Matrix3d {
+        for (int i = 0; i < 3; ++i) {
+          v(i, i) += std::clamp(v(i, i), kMinDiagonal, kMaxDiagonal) / mu;
+        }
+        return v.llt().solve(Eigen::Matrix3d::Identity());
+      },
+      &rhs);
+  // S += D / mu.
+  std::vector<double>& s = reduced_values;
   for (size_t g = 0; g < groups.size(); ++g) {
     const Group& group = groups[g];
     for (int i = 0; i < group.size; ++i) {
@@ -1042,12 +1139,7 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
           d_camera[group.offset + i] / mu;
     }
   }
-  double* values = reduced.valuePtr();
-  const int64_t num_values = static_cast<int64_t>(reduced_value_source.size());
-#pragma omp parallel for schedule(static) num_threads(NumThreads())
-  for (int64_t k = 0; k < num_values; ++k) {
-    values[k] = s[reduced_value_source[k]];
-  }
+  CopyReducedValues();
   *schur_seconds += Seconds(schur_start);
   const auto factorization_start = std::chrono::steady_clock::now();
   cholesky.factorize(reduced);
@@ -1064,21 +1156,13 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
   const int num_points = static_cast<int>(points.size());
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int p = 0; p < num_points; ++p) {
+    Eigen::Map<Eigen::Vector3d> step(&point_step[3 * p]);
     if (point_held[p]) {
-      std::fill(&point_step[3 * p], &point_step[3 * p] + 3, 0.0);
+      step.setZero();
       continue;
     }
-    const PointStructure structure = StructureOf(p);
-    Eigen::Vector3d right = -Eigen::Map<const Eigen::Vector3d>(&point_b[3 * p]);
-    for (int i = 0; i < structure.num_groups; ++i) {
-      const Group& group = groups[structure.groups[i]];
-      Eigen::Vector3d w_delta = Eigen::Vector3d::Zero();
-      AddAB(&point_w[structure.w_offset[i]], camera_step.data() + group.offset,
-            3, group.size, 1, w_delta.data(), 1);
-      right -= w_delta;
-    }
-    Eigen::Map<Eigen::Vector3d> step(&point_step[3 * p]);
-    step = Eigen::Map<const Eigen::Matrix3d>(&point_v_inverse[9 * p]) * right;
+    step = SolvePoint(p, -Eigen::Map<const Eigen::Vector3d>(&point_b[3 * p]),
+                      camera_step.data());
   }
   return std::all_of(point_step.begin(), point_step.end(),
                      [](double x) { return std::isfinite(x); });
@@ -1253,6 +1337,88 @@ size_t BundleLevenbergMarquardt::AddResidualBlock(
   return impl_->residuals.size() - 1;
 }
 
+bool BundleLevenbergMarquardt::LinearizeGaussNewton(std::string* error) {
+  Impl& impl = *impl_;
+  if (!impl.structure_valid) {
+    impl.structure_valid = impl.BuildStructure(error);
+    if (!impl.structure_valid) return false;
+  }
+  impl.robust_loss = false;
+  double cost = 0;
+  const bool evaluated = impl.Evaluate(/*linearize=*/true, &cost);
+  impl.robust_loss = true;
+  if (!evaluated) {
+    *error = "the residuals could not be evaluated at the current values";
+    return false;
+  }
+  impl.point_rank.assign(impl.points.size(), 0);
+  Eigen::VectorXd rhs;
+  impl.EliminatePoints(
+      [&impl](int p, const Eigen::Matrix3d& v) {
+        return PointPseudoInverse(v, &impl.point_rank[p]);
+      },
+      &rhs);
+  impl.CopyReducedValues();
+  return true;
+}
+
+const Eigen::SparseMatrix<double>& BundleLevenbergMarquardt::ReducedMatrix()
+    const {
+  return impl_->reduced;
+}
+
+int BundleLevenbergMarquardt::GroupOffset(int group) const {
+  return impl_->groups[group].offset;
+}
+
+int64_t BundleLevenbergMarquardt::NumDeterminedPointParameters() const {
+  int64_t sum = 0;
+  for (const int rank : impl_->point_rank) sum += rank;
+  return sum;
+}
+
+Eigen::Vector2d BundleLevenbergMarquardt::Residual(size_t index) const {
+  return Eigen::Vector2d(impl_->residual_values[2 * index],
+                         impl_->residual_values[2 * index + 1]);
+}
+
+Eigen::Vector3d BundleLevenbergMarquardt::AddGradient(
+    size_t index, double weight, Eigen::VectorXd* camera_gradient) const {
+  const Impl& impl = *impl_;
+  const Impl::Residual& residual = impl.residuals[index];
+  const Eigen::Vector2d r = weight * Residual(index);
+  for (int i = 0; i < residual.num_groups; ++i) {
+    const Impl::Group& group = impl.groups[residual.groups[i]];
+    AddATransposeB(&impl.jacobians[residual.group_jacobian[i]], r.data(), 2,
+                   group.size, 1, 1, camera_gradient->data() + group.offset,
+                   1);
+  }
+  if (residual.point < 0) return Eigen::Vector3d::Zero();
+  return Eigen::Map<const Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(
+             &impl.jacobians[residual.point_jacobian])
+             .transpose() *
+         r;
+}
+
+void BundleLevenbergMarquardt::EliminatePointVector(
+    int point, const Eigen::Vector3d& b_p, Eigen::VectorXd* b_c) const {
+  const Impl& impl = *impl_;
+  const Eigen::Vector3d solved =
+      Eigen::Map<const Eigen::Matrix3d>(&impl.point_v_inverse[9 * point]) *
+      b_p;
+  const Impl::PointStructure structure = impl.StructureOf(point);
+  for (int i = 0; i < structure.num_groups; ++i) {
+    const Impl::Group& group = impl.groups[structure.groups[i]];
+    AddATransposeB(&impl.point_w[structure.w_offset[i]], solved.data(), 3,
+                   group.size, 1, -1, b_c->data() + group.offset, 1);
+  }
+}
+
+Eigen::Vector3d BundleLevenbergMarquardt::BackSubstitutePoint(
+    int point, const Eigen::Vector3d& b_p, const Eigen::VectorXd& x_c) const {
+  return impl_->SolvePoint(point, b_p, x_c.data());
+}
+
 void BundleLevenbergMarquardt::Solve(BundleSolverSummary* summary) {
   using Termination = BundleSolverSummary::Termination;
   Impl& impl = *impl_;
@@ -1272,10 +1438,18 @@ void BundleLevenbergMarquardt::Solve(BundleSolverSummary* summary) {
     summary->seconds = Seconds(start_time);
   };
   std::string error;
-  if (!impl.structure_valid) {
-    impl.structure_valid = impl.BuildStructure(&error);
+  if (!impl.structure_valid || !impl.pattern_analyzed) {
+    impl.structure_valid =
+        impl.structure_valid || impl.BuildStructure(&error);
+    if (impl.structure_valid) {
+      impl.cholesky.analyzePattern(impl.reduced);
+      impl.pattern_analyzed = impl.cholesky.info() == Eigen::Success;
+      if (!impl.pattern_analyzed) {
+        error = "the symbolic analysis of the reduced system failed";
+      }
+    }
     summary->structure_seconds = Seconds(start_time);
-    if (!impl.structure_valid) {
+    if (!impl.pattern_analyzed) {
       finish(Termination::kFailure, error, 0);
       return;
     }

@@ -43,6 +43,15 @@
 // gradient's largest entry is below gradient_tolerance, or after
 // max_num_iterations steps (accepted or not).
 //
+// Gauss-Newton system (LinearizeGaussNewton). The same evaluation and
+// elimination, without the robust loss and without damping, is the reduced
+// system that the calibration's covariance (calibration_uncertainty.h)
+// marginalizes: one implementation of "the Jacobians at the current values,
+// the points eliminated by their 3 x 3 blocks" for the step and the
+// covariance. There V_p may be singular (a point seen once has no
+// information along its ray), and V_p^+, its pseudo-inverse, takes the place
+// of V~_p^-1.
+//
 // Threads, deterministically. The residual blocks and the points are cut into
 // a fixed number of chunks, whatever the thread count; each chunk evaluates
 // into its own slots and adds its part of the reduced system, the costs and
@@ -51,7 +60,11 @@
 // whose threads add in the order they finish.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "src/geometry/tangent_jacobian_cost.h"
@@ -85,6 +98,44 @@ class BundleLevenbergMarquardt final : public BundleSolver {
 
   // After a failure midway, the values are the last accepted estimate.
   void Solve(BundleSolverSummary* summary) override;
+
+  // The Gauss-Newton reduced system at the current values (see the top of
+  // the file): J the Jacobian of the residuals with rho(s) = s, in the
+  // blocks' tangent spaces, U, V_p, W_p the camera-side, point and mixed
+  // blocks of J^T J (no damping), and
+  //
+  //   S = U - sum_p W_p^T V_p^+ W_p,
+  //
+  // V_p^+ the pseudo-inverse of V_p (eigenvalues below 1e-12 of the largest
+  // count as 0: a direction without information in V_p has none in W_p
+  // either, so the elimination is exact). Built by the step's code, in its
+  // chunks: bit-identical on any thread count. The Ceres backend has no
+  // counterpart; the covariance builds it with this class whatever backend
+  // ran the adjustment. False, with `error`, when the structure cannot be
+  // built or a residual cannot be evaluated. The accessors below read its
+  // result, valid until the next Solve or LinearizeGaussNewton.
+  bool LinearizeGaussNewton(std::string* error);
+  // The upper triangle of S; group g's tangent coordinates are its rows
+  // [GroupOffset(g), GroupOffset(g) + its size), its blocks' in the order
+  // they were added.
+  const Eigen::SparseMatrix<double>& ReducedMatrix() const;
+  int GroupOffset(int group) const;
+  // sum_p rank V_p: the point coordinates the data determine.
+  int64_t NumDeterminedPointParameters() const;
+  // r_t of residual block `index` (AddResidualBlock's), without loss.
+  Eigen::Vector2d Residual(size_t index) const;
+  // g_c += weight J_c^T r_t over the camera side (S's coordinates); returns
+  // weight J_p^T r_t over its point (zero without one).
+  Eigen::Vector3d AddGradient(size_t index, double weight,
+                              Eigen::VectorXd* camera_gradient) const;
+  // For a refined point p (AddPoint's index) with a point-side vector b_p of
+  // the full system [U W^T; W V] [x_c; x_p] = [b_c; b_p]: its elimination
+  // into the camera side, b_c -= W_p^T V_p^+ b_p, and its back-substitution,
+  // x_p = V_p^+ (b_p - W_p x_c).
+  void EliminatePointVector(int point, const Eigen::Vector3d& b_p,
+                            Eigen::VectorXd* b_c) const;
+  Eigen::Vector3d BackSubstitutePoint(int point, const Eigen::Vector3d& b_p,
+                                      const Eigen::VectorXd& x_c) const;
 
  private:
   struct Impl;

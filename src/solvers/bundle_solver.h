@@ -9,6 +9,11 @@
 //           own solver reaches the same minimum
 //           (tests/src/calibration/bundle_solver_backends_test.cc,
 //           docs/solver_comparison.md).
+// The own solver also gives the Gauss-Newton reduced system at the current
+// values (BundleLevenbergMarquardt::LinearizeGaussNewton), which the
+// calibration's covariance (calibration_uncertainty.h) marginalizes; it
+// builds it with the own solver whatever backend ran the adjustment, as
+// Ceres' has no such interface.
 //
 // Problem, for either. Residual blocks of 2 rows r_t(x), each a
 // ceres::CostFunction over up to three camera-side parameter blocks (a pose,

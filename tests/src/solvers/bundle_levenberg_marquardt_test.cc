@@ -590,5 +590,164 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
   EXPECT_LT(between.focal_relative, 1e-9);
 }
 
+// The solver's blocks over `scene` as SolveOurs adds them, with `loss`.
+void AddToSolver(Scene* scene, Problem* problem,
+                 const ceres::LossFunction* loss,
+                 BundleLevenbergMarquardt* solver) {
+  BuildProblem(scene, problem);
+  int group = 0;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    solver->AddParameterBlock(scene->rig_from_world[j].data(), 7,
+                              &problem->pose_manifold, group++);
+  }
+  solver->AddParameterBlock(scene->intrinsics[0].data(), 4, nullptr, group++);
+  solver->AddParameterBlock(scene->cam_from_rig[1].data(), 7,
+                            &problem->pose_manifold, group);
+  solver->AddParameterBlock(scene->intrinsics[1].data(), 4,
+                            &problem->principal_point_held, group++);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    solver->AddPoint(scene->points[p].data());
+  }
+  for (size_t k = 0; k < problem->costs.size(); ++k) {
+    solver->AddResidualBlock(problem->costs[k].get(), loss,
+                             problem->parameters[k]);
+  }
+}
+
+// LinearizeGaussNewton against the dense Schur complement of J^T J, J
+// Ceres' Jacobian (no loss) in the same tangent spaces, columns in the
+// solver's order (its groups, then the points): S, the residuals, the
+// gradient and the point-side eliminations and back-substitutions; and the
+// same bits on 1 and 2 threads.
+TEST(BundleLevenbergMarquardtTest, GaussNewtonSystemIsTheSchurComplement) {
+  const Scene truth = MakeScene(0.5, 0, 21);
+  Scene scene = Perturbed(truth, 22);
+  ceres::CauchyLoss loss(1.0);  // ignored by LinearizeGaussNewton
+  Problem problem;
+  BundleSolverOptions options;
+  options.num_threads = 1;
+  BundleLevenbergMarquardt solver(options);
+  AddToSolver(&scene, &problem, &loss, &solver);
+  std::string error;
+  ASSERT_TRUE(solver.LinearizeGaussNewton(&error)) << error;
+
+  // J from Ceres, columns: rig poses 1.., intrinsics 0, (cam_from_rig 1,
+  // intrinsics 1), points.
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    ceres_problem.AddResidualBlock(problem.costs[k].get(), nullptr,
+                                   problem.parameters[k]);
+  }
+  std::vector<double*> columns;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    ceres_problem.SetManifold(scene.rig_from_world[j].data(),
+                              &problem.pose_manifold);
+    columns.push_back(scene.rig_from_world[j].data());
+  }
+  columns.push_back(scene.intrinsics[0].data());
+  ceres_problem.SetManifold(scene.cam_from_rig[1].data(),
+                            &problem.pose_manifold);
+  columns.push_back(scene.cam_from_rig[1].data());
+  ceres_problem.SetManifold(scene.intrinsics[1].data(),
+                            &problem.principal_point_held);
+  columns.push_back(scene.intrinsics[1].data());
+  const int num_camera = 6 * (Scene::kNumFramesets - 1) + 4 + 6 + 2;
+  // The observed refined points: solver index -> J's point index (-1: none).
+  std::vector<int> point_column(Scene::kNumPoints - Scene::kNumFixedPoints,
+                                -1);
+  for (const Scene::Observation& observation : scene.observations) {
+    const int p = observation.point - Scene::kNumFixedPoints;
+    if (p >= 0 && point_column[p] < 0) point_column[p] = 0;
+  }
+  int num_points = 0;
+  for (size_t p = 0; p < point_column.size(); ++p) {
+    if (point_column[p] < 0) continue;
+    point_column[p] = num_points++;
+    columns.push_back(scene.points[Scene::kNumFixedPoints + p].data());
+  }
+  ceres::Problem::EvaluateOptions evaluate_options;
+  evaluate_options.parameter_blocks = columns;
+  evaluate_options.num_threads = 1;
+  std::vector<double> residuals;
+  ceres::CRSMatrix crs;
+  ASSERT_TRUE(ceres_problem.Evaluate(evaluate_options, nullptr, &residuals,
+                                     nullptr, &crs));
+  ASSERT_EQ(crs.num_cols, num_camera + 3 * num_points);
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
+      j(row, crs.cols[k]) = crs.values[k];
+    }
+  }
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(),
+                                            residuals.size());
+  const Eigen::MatrixXd h = j.transpose() * j;
+  const Eigen::MatrixXd u = h.topLeftCorner(num_camera, num_camera);
+  const Eigen::MatrixXd w = h.bottomLeftCorner(3 * num_points, num_camera);
+  const Eigen::MatrixXd v = h.bottomRightCorner(3 * num_points, 3 * num_points);
+  const Eigen::LDLT<Eigen::MatrixXd> v_ldlt(v);
+  const Eigen::MatrixXd s = u - w.transpose() * v_ldlt.solve(w);
+
+  const Eigen::SparseMatrix<double> full =
+      solver.ReducedMatrix().selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd reduced(full);
+  ASSERT_EQ(reduced.rows(), num_camera);
+  EXPECT_LT((reduced - s).cwiseAbs().maxCoeff(),
+            1e-9 * s.cwiseAbs().maxCoeff());
+  EXPECT_EQ(solver.GroupOffset(Scene::kNumFramesets), num_camera - 8);
+  EXPECT_EQ(solver.NumDeterminedPointParameters(), 3 * num_points);
+
+  // Residuals and the camera- and point-side gradient J^T r, weighted.
+  Eigen::VectorXd camera_gradient = Eigen::VectorXd::Zero(num_camera);
+  Eigen::VectorXd point_gradient = Eigen::VectorXd::Zero(3 * num_points);
+  for (size_t k = 0; k < problem.costs.size(); ++k) {
+    EXPECT_NEAR((solver.Residual(k) - r.segment<2>(2 * k)).norm(), 0, 1e-12);
+    const Eigen::Vector3d point = solver.AddGradient(k, 0.5, &camera_gradient);
+    const int p = scene.observations[k].point - Scene::kNumFixedPoints;
+    if (p >= 0) point_gradient.segment<3>(3 * point_column[p]) += point;
+  }
+  const Eigen::VectorXd gradient = 0.5 * j.transpose() * r;
+  EXPECT_LT((camera_gradient - gradient.head(num_camera)).norm(),
+            1e-9 * gradient.norm());
+  EXPECT_LT((point_gradient - gradient.tail(3 * num_points)).norm(),
+            1e-9 * gradient.norm());
+
+  // b_c - W^T V^-1 b_p and V^-1 (b_p - W x_c) for random b_p, x_c.
+  std::mt19937 rng(23);
+  std::normal_distribution<double> normal(0, 1);
+  Eigen::VectorXd b_p(3 * num_points), x_c(num_camera);
+  for (int i = 0; i < b_p.size(); ++i) b_p(i) = normal(rng);
+  for (int i = 0; i < x_c.size(); ++i) x_c(i) = normal(rng);
+  Eigen::VectorXd eliminated = Eigen::VectorXd::Zero(num_camera);
+  Eigen::VectorXd solved(3 * num_points);
+  for (size_t p = 0; p < point_column.size(); ++p) {
+    const int column = point_column[p];
+    if (column < 0) continue;
+    solver.EliminatePointVector(static_cast<int>(p),
+                                b_p.segment<3>(3 * column), &eliminated);
+    solved.segment<3>(3 * column) = solver.BackSubstitutePoint(
+        static_cast<int>(p), b_p.segment<3>(3 * column), x_c);
+  }
+  const Eigen::VectorXd expected_eliminated =
+      -w.transpose() * v_ldlt.solve(b_p);
+  EXPECT_LT((eliminated - expected_eliminated).norm(),
+            1e-9 * expected_eliminated.norm());
+  const Eigen::VectorXd expected_solved = v_ldlt.solve(b_p - w * x_c);
+  EXPECT_LT((solved - expected_solved).norm(), 1e-9 * expected_solved.norm());
+
+  // Bit-identical on two threads.
+  Scene again = Perturbed(truth, 22);
+  Problem again_problem;
+  options.num_threads = 2;
+  BundleLevenbergMarquardt two_threads(options);
+  AddToSolver(&again, &again_problem, &loss, &two_threads);
+  ASSERT_TRUE(two_threads.LinearizeGaussNewton(&error)) << error;
+  EXPECT_EQ(Eigen::MatrixXd(two_threads.ReducedMatrix()),
+            Eigen::MatrixXd(solver.ReducedMatrix()));
+}
+
 }  // namespace
 }  // namespace rig_calibrator
