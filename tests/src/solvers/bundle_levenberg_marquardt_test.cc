@@ -188,33 +188,43 @@ void BuildProblem(Scene* scene, Problem* problem, bool ambient_only = false) {
   }
 }
 
+// The problem over `scene` (BuildProblem) in `solver`, with `loss`: every
+// rig pose but the first, camera 0's intrinsics, camera 1's cam_from_rig
+// and intrinsics (principal point held) refined, and the points that are
+// not fixed.
+void AddToSolver(Scene* scene, Problem* problem,
+                 const ceres::LossFunction* loss,
+                 BundleLevenbergMarquardt* solver, bool ambient_only = false) {
+  BuildProblem(scene, problem, ambient_only);
+  int group = 0;
+  for (int j = 1; j < Scene::kNumFramesets; ++j) {
+    solver->AddParameterBlock(scene->rig_from_world[j].data(), 7,
+                              &problem->pose_manifold, group++);
+  }
+  solver->AddParameterBlock(scene->intrinsics[0].data(), 4, nullptr, group++);
+  solver->AddParameterBlock(scene->cam_from_rig[1].data(), 7,
+                            &problem->pose_manifold, group);
+  solver->AddParameterBlock(scene->intrinsics[1].data(), 4,
+                            &problem->principal_point_held, group++);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    solver->AddPoint(scene->points[p].data());
+  }
+  for (size_t k = 0; k < problem->costs.size(); ++k) {
+    solver->AddResidualBlock(problem->costs[k].get(), loss,
+                             problem->parameters[k]);
+  }
+}
+
 void SolveOurs(const ceres::LossFunction* loss, int num_threads, Scene* scene,
                BundleSolverSummary* summary,
                bool ambient_only = false) {
   Problem problem;
-  BuildProblem(scene, &problem, ambient_only);
   BundleSolverOptions options;
   options.parameter_tolerance = 1e-12;
   options.function_tolerance = 1e-12;
   options.num_threads = num_threads;
   BundleLevenbergMarquardt solver(options);
-  int group = 0;
-  for (int j = 1; j < Scene::kNumFramesets; ++j) {
-    solver.AddParameterBlock(scene->rig_from_world[j].data(), 7,
-                             &problem.pose_manifold, group++);
-  }
-  solver.AddParameterBlock(scene->intrinsics[0].data(), 4, nullptr, group++);
-  solver.AddParameterBlock(scene->cam_from_rig[1].data(), 7,
-                           &problem.pose_manifold, group);
-  solver.AddParameterBlock(scene->intrinsics[1].data(), 4,
-                           &problem.principal_point_held, group++);
-  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
-    solver.AddPoint(scene->points[p].data());
-  }
-  for (size_t k = 0; k < problem.costs.size(); ++k) {
-    solver.AddResidualBlock(problem.costs[k].get(), loss,
-                            problem.parameters[k]);
-  }
+  AddToSolver(scene, &problem, loss, &solver, ambient_only);
   solver.Solve(summary);
 }
 
@@ -588,30 +598,6 @@ TEST(BundleLevenbergMarquardtTest, InactiveBlocksAndHeldPointsActAsRemoved) {
   EXPECT_LT(between.translation, 1e-7);
   EXPECT_LT(between.point, 1e-6);
   EXPECT_LT(between.focal_relative, 1e-9);
-}
-
-// The solver's blocks over `scene` as SolveOurs adds them, with `loss`.
-void AddToSolver(Scene* scene, Problem* problem,
-                 const ceres::LossFunction* loss,
-                 BundleLevenbergMarquardt* solver) {
-  BuildProblem(scene, problem);
-  int group = 0;
-  for (int j = 1; j < Scene::kNumFramesets; ++j) {
-    solver->AddParameterBlock(scene->rig_from_world[j].data(), 7,
-                              &problem->pose_manifold, group++);
-  }
-  solver->AddParameterBlock(scene->intrinsics[0].data(), 4, nullptr, group++);
-  solver->AddParameterBlock(scene->cam_from_rig[1].data(), 7,
-                            &problem->pose_manifold, group);
-  solver->AddParameterBlock(scene->intrinsics[1].data(), 4,
-                            &problem->principal_point_held, group++);
-  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
-    solver->AddPoint(scene->points[p].data());
-  }
-  for (size_t k = 0; k < problem->costs.size(); ++k) {
-    solver->AddResidualBlock(problem->costs[k].get(), loss,
-                             problem->parameters[k]);
-  }
 }
 
 // LinearizeGaussNewton against the dense Schur complement of J^T J, J
