@@ -228,18 +228,28 @@ void SolveOurs(const ceres::LossFunction* loss, int num_threads, Scene* scene,
   solver.Solve(summary);
 }
 
-double SolveCeres(ceres::LossFunction* loss, Scene* scene) {
-  Problem problem;
-  BuildProblem(scene, &problem);
+// The residual blocks of `problem` in a Ceres problem that owns none of
+// them (nor `loss` or the manifolds set later).
+std::unique_ptr<ceres::Problem> CeresProblemOf(const Problem& problem,
+                                               ceres::LossFunction* loss) {
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem ceres_problem(problem_options);
+  auto ceres_problem = std::make_unique<ceres::Problem>(problem_options);
   for (size_t k = 0; k < problem.costs.size(); ++k) {
-    ceres_problem.AddResidualBlock(problem.costs[k].get(), loss,
-                                   problem.parameters[k]);
+    ceres_problem->AddResidualBlock(problem.costs[k].get(), loss,
+                                    problem.parameters[k]);
   }
+  return ceres_problem;
+}
+
+double SolveCeres(ceres::LossFunction* loss, Scene* scene) {
+  Problem problem;
+  BuildProblem(scene, &problem);
+  const std::unique_ptr<ceres::Problem> ceres_problem_pointer =
+      CeresProblemOf(problem, loss);
+  ceres::Problem& ceres_problem = *ceres_problem_pointer;
   ceres_problem.SetParameterBlockConstant(scene->rig_from_world[0].data());
   ceres_problem.SetParameterBlockConstant(scene->cam_from_rig[0].data());
   for (int j = 1; j < Scene::kNumFramesets; ++j) {
@@ -619,14 +629,9 @@ TEST(BundleLevenbergMarquardtTest, GaussNewtonSystemIsTheSchurComplement) {
 
   // J from Ceres, columns: rig poses 1.., intrinsics 0, (cam_from_rig 1,
   // intrinsics 1), points.
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem ceres_problem(problem_options);
-  for (size_t k = 0; k < problem.costs.size(); ++k) {
-    ceres_problem.AddResidualBlock(problem.costs[k].get(), nullptr,
-                                   problem.parameters[k]);
-  }
+  const std::unique_ptr<ceres::Problem> ceres_problem_pointer =
+      CeresProblemOf(problem, nullptr);
+  ceres::Problem& ceres_problem = *ceres_problem_pointer;
   std::vector<double*> columns;
   for (int j = 1; j < Scene::kNumFramesets; ++j) {
     ceres_problem.SetManifold(scene.rig_from_world[j].data(),
