@@ -6,6 +6,12 @@ repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${RIG_CALIBRATOR_BUILD_DIR:-$repo/build}"
 rig_calibrator="$build/rig_calibrator"
 rig_calibrator_lab="$build/rig_calibrator_lab"
+# New build folders (build/, the sanitizer's, the fuzzer's) use Ninja, which
+# compiles the objects of a library while the libraries below it are still
+# compiling; one made earlier keeps its generator.
+if [[ -z "${CMAKE_GENERATOR:-}" ]] && command -v ninja > /dev/null 2>&1; then
+  export CMAKE_GENERATOR=Ninja
+fi
 
 # Prints "[log_tag] ERROR: message" and exits 1.
 die() { echo "[$log_tag] ERROR: $*" >&2; exit 1; }

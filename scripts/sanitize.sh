@@ -4,8 +4,8 @@
 # $RIG_CALIBRATOR_SANITIZE_BUILD_DIR) and runs every test (unit and e2e) there.
 # Any ASan or UBSan report fails the test that triggered it. Extra arguments go
 # to ctest (e.g. -LE e2e for the unit tests only).
-#   RIG_CALIBRATOR_SANITIZE_TARGETS="input_limits_test database_reader_test"
-#   builds (and so runs) only those test executables.
+#   RIG_CALIBRATOR_SANITIZE_TARGETS="colmap_io_tests geometry_tests" builds
+#   (and so runs) only those test executables (one per tested folder).
 #
 # Our code is instrumented; COLMAP's, Ceres' and the system's libraries are
 # not, so a bug inside them is out of reach, but every access our code makes

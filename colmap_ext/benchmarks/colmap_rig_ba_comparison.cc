@@ -16,6 +16,7 @@
 
 #include "colmap_ext/benchmarks/child_process.h"
 #include "colmap_ext/benchmarks/runtime_benchmark_options.h"
+#include "colmap_ext/benchmarks/table_cells.h"
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
@@ -486,16 +487,6 @@ bool RunOurSide(const ColmapRigBaComparisonOptions& options, int num_threads,
   return true;
 }
 
-std::string Fixed(double value, int digits) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(digits) << value;
-  return text.str();
-}
-
-std::string Ratio(double colmap, double ours) {
-  return ours > 0 ? Fixed(colmap / ours, 2) : "-";
-}
-
 std::string Csv(const std::vector<Comparison>& comparisons) {
   std::ostringstream csv;
   csv << "framesets,cameras,images,framesets_used,points,who,observations,"
@@ -557,27 +548,27 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
                              std::to_string(c.data->num_points) + " points)";
     for (const SolverRun* run : {&c.ours, &c.colmap}) {
       md << "| " << size << " | " << run->who << " | " << run->num_observations
-         << " | " << run->num_iterations << " | " << Fixed(run->wall_seconds, 2)
-         << " | " << Fixed(run->cpu_seconds, 2) << " | "
-         << (run->ceres_seconds >= 0 ? Fixed(run->ceres_seconds, 2) : "-")
+         << " | " << run->num_iterations << " | " << FixedCell(run->wall_seconds, 2)
+         << " | " << FixedCell(run->cpu_seconds, 2) << " | "
+         << (run->ceres_seconds >= 0 ? FixedCell(run->ceres_seconds, 2) : "-")
          << " | "
-         << Fixed(run->wall_seconds / std::max(1, run->num_iterations), 3)
-         << " | " << Fixed(run->initial_rms_px, 4) << " -> "
-         << Fixed(run->final_rms_px, 6)
+         << FixedCell(run->wall_seconds / std::max(1, run->num_iterations), 3)
+         << " | " << FixedCell(run->initial_rms_px, 4) << " -> "
+         << FixedCell(run->final_rms_px, 6)
          << (run->num_behind > 0
                  ? " (" + std::to_string(run->num_behind) + " behind camera)"
                  : "")
-         << " | " << Fixed(run->max_rotation_error_deg, 4) << " | "
-         << Fixed(1000 * run->max_center_error_m, 3) << " | "
+         << " | " << FixedCell(run->max_rotation_error_deg, 4) << " | "
+         << FixedCell(1000 * run->max_center_error_m, 3) << " | "
          << run->termination << " |\n";
     }
     md << "| " << size << " | **COLMAP / ours** | | "
-       << Ratio(c.colmap.num_iterations, c.ours.num_iterations) << " | **"
-       << Ratio(c.colmap.wall_seconds, c.ours.wall_seconds) << "** | "
-       << Ratio(c.colmap.cpu_seconds, c.ours.cpu_seconds) << " | | "
-       << Ratio(c.colmap.wall_seconds / std::max(1, c.colmap.num_iterations),
+       << RatioCell(c.colmap.num_iterations, c.ours.num_iterations) << " | **"
+       << RatioCell(c.colmap.wall_seconds, c.ours.wall_seconds) << "** | "
+       << RatioCell(c.colmap.cpu_seconds, c.ours.cpu_seconds) << " | | "
+       << RatioCell(c.colmap.wall_seconds / std::max(1, c.colmap.num_iterations),
                 c.ours.wall_seconds / std::max(1, c.ours.num_iterations))
-       << " | " << Ratio(c.colmap.final_rms_px, c.ours.final_rms_px)
+       << " | " << RatioCell(c.colmap.final_rms_px, c.ours.final_rms_px)
        << " | | | |\n";
   }
   md << "\nPer size: COLMAP's linear solver (its choice by image count) and "
@@ -587,7 +578,7 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
   for (const Comparison& c : comparisons) {
     md << "- " << c.framesets << " x " << c.cameras << ": COLMAP "
        << c.colmap_linear_solver << ", ours " << kOurLinearSolver << "; "
-       << "model_converter " << Fixed(c.colmap_io_seconds, 2) << " s; "
+       << "model_converter " << FixedCell(c.colmap_io_seconds, 2) << " s; "
        << c.data->num_framesets << " framesets compared, "
        << c.data->num_dropped_framesets << " dropped; "
        << c.data->observations.size() << " of the start's "
@@ -595,7 +586,7 @@ std::string Markdown(const ColmapRigBaComparisonOptions& options,
        << c.data->num_single_observations
        << " of points seen once left out); COLMAP's own final RMS (2 x its "
           "printed final cost) "
-       << Fixed(c.colmap.reported_rms_px, 6) << " px\n";
+       << FixedCell(c.colmap.reported_rms_px, 6) << " px\n";
   }
   return md.str();
 }

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "colmap_ext/benchmarks/table_cells.h"
 #include "colmap_ext/report/svg_plot.h"
 
 namespace rig_calibrator {
@@ -23,13 +24,6 @@ constexpr char kLocalizationHeader[] = "rig_calibrator localization runtime";
 std::string OneLine(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
   std::replace(text.begin(), text.end(), '\r', ' ');
-  return text;
-}
-
-std::string Fixed(double value, int digits) {
-  if (!std::isfinite(value)) return "-";
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
   return text;
 }
 
@@ -307,15 +301,15 @@ std::string CalibrationRuntimeCsv(const std::vector<CalibrationRuntime>& runs) {
     for (const std::string& stage : stages) {
       const StageTotals totals = StageSeconds(run, stage);
       const bool ran = std::isfinite(totals.seconds);
-      csv << "," << (ran ? Fixed(totals.seconds, 3) : "") << ","
-          << (ran ? Fixed(totals.cpu_seconds, 3) : "") << ","
+      csv << "," << (ran ? FixedCell(totals.seconds, 3) : "") << ","
+          << (ran ? FixedCell(totals.cpu_seconds, 3) : "") << ","
           << (ran ? std::to_string(totals.num_iterations) : "");
     }
-    csv << "," << Fixed(run.seconds, 3) << "," << Fixed(run.cpu_seconds, 3)
-        << "," << Fixed(run.peak_memory_mb, 1) << ","
-        << Fixed(run.final_rms_px, 4) << ","
-        << Fixed(run.max_rotation_error_deg, 4) << ","
-        << Fixed(run.max_center_error_m, 5) << "\n";
+    csv << "," << FixedCell(run.seconds, 3) << "," << FixedCell(run.cpu_seconds, 3)
+        << "," << FixedCell(run.peak_memory_mb, 1) << ","
+        << FixedCell(run.final_rms_px, 4) << ","
+        << FixedCell(run.max_rotation_error_deg, 4) << ","
+        << FixedCell(run.max_center_error_m, 5) << "\n";
   }
   return csv.str();
 }
@@ -331,14 +325,14 @@ std::string LocalizationRuntimeCsv(
     csv << run.mode << "," << run.num_map_images << "," << run.num_map_points
         << "," << run.num_indexed_descriptors << ","
         << run.features_per_rig_image << "," << run.num_checks << ","
-        << run.num_images << "," << Fixed(run.index_seconds, 3) << ","
-        << Fixed(run.index_cpu_seconds, 3) << "," << Fixed(run.seconds, 3)
-        << "," << Fixed(run.cpu_seconds, 3) << ","
-        << Fixed(run.ImagesPerSecond(), 2) << ","
-        << Fixed(run.CpuSecondsPerImage(), 4) << "," << Fixed(run.recall, 4)
-        << "," << Fixed(run.precision, 4) << ","
-        << Fixed(run.radial_pose_seconds_per_image, 5) << ","
-        << run.num_poses_correct << "," << Fixed(run.peak_memory_mb, 1) << "\n";
+        << run.num_images << "," << FixedCell(run.index_seconds, 3) << ","
+        << FixedCell(run.index_cpu_seconds, 3) << "," << FixedCell(run.seconds, 3)
+        << "," << FixedCell(run.cpu_seconds, 3) << ","
+        << FixedCell(run.ImagesPerSecond(), 2) << ","
+        << FixedCell(run.CpuSecondsPerImage(), 4) << "," << FixedCell(run.recall, 4)
+        << "," << FixedCell(run.precision, 4) << ","
+        << FixedCell(run.radial_pose_seconds_per_image, 5) << ","
+        << run.num_poses_correct << "," << FixedCell(run.peak_memory_mb, 1) << "\n";
   }
   return csv.str();
 }
@@ -383,19 +377,19 @@ std::string CalibrationRuntimeMarkdown(
        << run.num_images << " | " << run.num_correspondences << " |";
     for (const std::string& stage : stages) {
       const StageTotals totals = StageSeconds(run, stage);
-      md << " " << Fixed(totals.seconds, 2) << " ("
-         << Fixed(totals.cpu_seconds, 2) << ")"
+      md << " " << FixedCell(totals.seconds, 2) << " ("
+         << FixedCell(totals.cpu_seconds, 2) << ")"
          << (totals.num_iterations > 0
                  ? " [" + std::to_string(totals.num_iterations) + "]"
                  : "")
          << " |";
     }
-    md << " " << Fixed(run.seconds, 2) << " | " << Fixed(run.cpu_seconds, 2)
-       << " | " << Fixed(run.peak_memory_mb, 0) << " | ";
+    md << " " << FixedCell(run.seconds, 2) << " | " << FixedCell(run.cpu_seconds, 2)
+       << " | " << FixedCell(run.peak_memory_mb, 0) << " | ";
     if (run.success) {
-      md << Fixed(run.final_rms_px, 3) << " | "
-         << Fixed(run.max_rotation_error_deg, 3) << " | "
-         << Fixed(1000 * run.max_center_error_m, 2) << " |\n";
+      md << FixedCell(run.final_rms_px, 3) << " | "
+         << FixedCell(run.max_rotation_error_deg, 3) << " | "
+         << FixedCell(1000 * run.max_center_error_m, 2) << " |\n";
     } else {
       md << "failed: " << run.error << " | - | - |\n";
     }
@@ -406,7 +400,7 @@ std::string CalibrationRuntimeMarkdown(
     const double exponent = GrowthExponent(runs, num_cameras);
     if (std::isfinite(exponent)) {
       md << "Growth with " << num_cameras << " cameras: CPU time ~ framesets^"
-         << Fixed(exponent, 2)
+         << FixedCell(exponent, 2)
          << " between the smallest and the largest run (1 = linear).\n";
     }
   }
@@ -426,14 +420,14 @@ std::string LocalizationRuntimeMarkdown(
     md << "| " << run.mode << " | " << run.num_map_images << " | "
        << run.num_map_points << " | " << run.features_per_rig_image << " | "
        << (run.mode == "direct" ? std::to_string(run.num_checks) : "-") << " | "
-       << run.num_images << " | " << Fixed(run.index_seconds, 2) << " ("
-       << Fixed(run.index_cpu_seconds, 2) << ") | "
-       << Fixed(run.ImagesPerSecond(), 2) << " | "
-       << Fixed(run.CpuSecondsPerImage(), 3) << " | " << Fixed(run.recall, 3)
-       << " | " << Fixed(run.precision, 3) << " | "
-       << Fixed(1000 * run.radial_pose_seconds_per_image, 2) << " | "
+       << run.num_images << " | " << FixedCell(run.index_seconds, 2) << " ("
+       << FixedCell(run.index_cpu_seconds, 2) << ") | "
+       << FixedCell(run.ImagesPerSecond(), 2) << " | "
+       << FixedCell(run.CpuSecondsPerImage(), 3) << " | " << FixedCell(run.recall, 3)
+       << " | " << FixedCell(run.precision, 3) << " | "
+       << FixedCell(1000 * run.radial_pose_seconds_per_image, 2) << " | "
        << run.num_poses_correct << "/" << run.num_images << " | "
-       << Fixed(run.peak_memory_mb, 0) << " |\n";
+       << FixedCell(run.peak_memory_mb, 0) << " |\n";
   }
   return md.str();
 }
@@ -442,19 +436,15 @@ namespace {
 
 std::string StageCell(const StageTotals& totals) {
   if (!std::isfinite(totals.seconds)) return "-";
-  return Fixed(totals.seconds, 2) + " (" + Fixed(totals.cpu_seconds, 2) + ")" +
+  return FixedCell(totals.seconds, 2) + " (" + FixedCell(totals.cpu_seconds, 2) + ")" +
          (totals.num_iterations > 0
               ? " [" + std::to_string(totals.num_iterations) + "]"
               : "");
 }
 
-std::string Ratio(double before, double after) {
-  return after > 0 && std::isfinite(before) ? Fixed(before / after, 2) : "-";
-}
-
 // Relative change of an error, in percent.
 std::string Change(double before, double after) {
-  return before > 0 ? Fixed(100 * (after - before) / before, 1) + " %" : "-";
+  return before > 0 ? FixedCell(100 * (after - before) / before, 1) + " %" : "-";
 }
 
 }  // namespace
@@ -475,30 +465,30 @@ std::string CalibrationBeforeAfterMarkdown(
       const StageTotals tb = StageSeconds(b, stage);
       const StageTotals ta = StageSeconds(a, stage);
       md << "| " << stage << " | " << StageCell(tb) << " | " << StageCell(ta)
-         << " | " << Ratio(tb.seconds, ta.seconds) << " | "
-         << Ratio(tb.cpu_seconds, ta.cpu_seconds) << " |\n";
+         << " | " << RatioCell(tb.seconds, ta.seconds) << " | "
+         << RatioCell(tb.cpu_seconds, ta.cpu_seconds) << " |\n";
     }
-    md << "| **total** | " << Fixed(b.seconds, 2) << " ("
-       << Fixed(b.cpu_seconds, 2) << ") | " << Fixed(a.seconds, 2) << " ("
-       << Fixed(a.cpu_seconds, 2) << ") | " << Ratio(b.seconds, a.seconds)
-       << " | " << Ratio(b.cpu_seconds, a.cpu_seconds) << " |\n"
-       << "| peak memory MB | " << Fixed(b.peak_memory_mb, 0) << " | "
-       << Fixed(a.peak_memory_mb, 0) << " | "
-       << Ratio(b.peak_memory_mb, a.peak_memory_mb) << " | |\n\n"
+    md << "| **total** | " << FixedCell(b.seconds, 2) << " ("
+       << FixedCell(b.cpu_seconds, 2) << ") | " << FixedCell(a.seconds, 2) << " ("
+       << FixedCell(a.cpu_seconds, 2) << ") | " << RatioCell(b.seconds, a.seconds)
+       << " | " << RatioCell(b.cpu_seconds, a.cpu_seconds) << " |\n"
+       << "| peak memory MB | " << FixedCell(b.peak_memory_mb, 0) << " | "
+       << FixedCell(a.peak_memory_mb, 0) << " | "
+       << RatioCell(b.peak_memory_mb, a.peak_memory_mb) << " | |\n\n"
        << "| against the truth | before | after | change |\n"
        << "|---|---|---|---|\n"
        << "| success | " << (b.success ? "yes" : "no: " + b.error) << " | "
        << (a.success ? "yes" : "no: " + a.error) << " | |\n"
-       << "| final RMS px | " << Fixed(b.final_rms_px, 4) << " | "
-       << Fixed(a.final_rms_px, 4) << " | "
+       << "| final RMS px | " << FixedCell(b.final_rms_px, 4) << " | "
+       << FixedCell(a.final_rms_px, 4) << " | "
        << Change(b.final_rms_px, a.final_rms_px) << " |\n"
        << "| worst camera rotation error deg | "
-       << Fixed(b.max_rotation_error_deg, 4) << " | "
-       << Fixed(a.max_rotation_error_deg, 4) << " | "
+       << FixedCell(b.max_rotation_error_deg, 4) << " | "
+       << FixedCell(a.max_rotation_error_deg, 4) << " | "
        << Change(b.max_rotation_error_deg, a.max_rotation_error_deg) << " |\n"
        << "| worst camera center error mm | "
-       << Fixed(1000 * b.max_center_error_m, 3) << " | "
-       << Fixed(1000 * a.max_center_error_m, 3) << " | "
+       << FixedCell(1000 * b.max_center_error_m, 3) << " | "
+       << FixedCell(1000 * a.max_center_error_m, 3) << " | "
        << Change(b.max_center_error_m, a.max_center_error_m) << " |\n\n";
   }
   return md.str();

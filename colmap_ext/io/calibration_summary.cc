@@ -5,6 +5,7 @@
 
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/coverage_json.h"
+#include "colmap_ext/io/json_number.h"
 #include "colmap_ext/io/model_validity_json.h"
 #include "colmap_ext/io/rig_description.h"
 #include "colmap_ext/io/uncertainty_json.h"
@@ -63,11 +64,6 @@ CalibrationSummary SummarizeCalibration(
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-// JSON has no NaN or infinity; a non-finite value becomes null.
-Json Number(const double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
 
 bool WriteJson(const std::string& path, const Json& root, std::string* error) {
   return WriteFileAtomically(
@@ -131,17 +127,17 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["height"] = camera.camera.Height();
     node["params"] = Json::array();
     for (const double param : camera.camera.Params()) {
-      node["params"].push_back(Number(param));
+      node["params"].push_back(JsonNumber(param));
     }
     if (camera.cam_from_rig) {
       const Rigid3d& pose = *camera.cam_from_rig;
       node["cam_from_rig"] = {
           {"rotation_wxyz",
-           {Number(pose.rotation.w()), Number(pose.rotation.x()),
-            Number(pose.rotation.y()), Number(pose.rotation.z())}},
+           {JsonNumber(pose.rotation.w()), JsonNumber(pose.rotation.x()),
+            JsonNumber(pose.rotation.y()), JsonNumber(pose.rotation.z())}},
           {"translation",
-           {Number(pose.translation.x()), Number(pose.translation.y()),
-            Number(pose.translation.z())}}};
+           {JsonNumber(pose.translation.x()), JsonNumber(pose.translation.y()),
+            JsonNumber(pose.translation.z())}}};
     } else {
       node["cam_from_rig"] = nullptr;
     }
@@ -149,8 +145,8 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["num_localized"] = camera.num_localized;
     node["num_used"] = camera.num_used;
     node["num_inliers"] = camera.num_inliers;
-    node["radial_rms_px"] = Number(camera.radial_rms_px);
-    node["rms_px"] = Number(camera.rms_px);
+    node["radial_rms_px"] = JsonNumber(camera.radial_rms_px);
+    node["rms_px"] = JsonNumber(camera.rms_px);
     AddCameraModelJson(camera.camera_model, &node);
     AddCoverageJson(camera, &node);
     cameras.push_back(node);
@@ -166,20 +162,20 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     for (const KnownPoseComparison& comparison : summary.known_rig_comparison) {
       known["cameras"].push_back(
           {{"name", comparison.camera},
-           {"rotation_error_deg", Number(comparison.rotation_error_deg)},
-           {"translation_error", Number(comparison.translation_error)},
+           {"rotation_error_deg", JsonNumber(comparison.rotation_error_deg)},
+           {"translation_error", JsonNumber(comparison.translation_error)},
            {"known_translation_norm",
-            Number(comparison.known_translation_norm)}});
+            JsonNumber(comparison.known_translation_norm)}});
     }
     root["known_rig"] = known;
   }
   if (summary.map_images) {
     const MapImagesSummary& map = *summary.map_images;
     root["map_images"] = {
-        {"input_mean_error_px", Number(map.input_mean_error_px)},
-        {"output_mean_error_px", Number(map.output_mean_error_px)},
-        {"input_max_error_px", Number(map.input_max_error_px)},
-        {"output_max_error_px", Number(map.output_max_error_px)},
+        {"input_mean_error_px", JsonNumber(map.input_mean_error_px)},
+        {"output_mean_error_px", JsonNumber(map.output_mean_error_px)},
+        {"input_max_error_px", JsonNumber(map.input_max_error_px)},
+        {"output_max_error_px", JsonNumber(map.output_max_error_px)},
         {"num_input_observations", map.num_input_observations},
         {"num_output_observations", map.num_output_observations},
         {"num_dropped_observations", map.num_dropped_observations}};
@@ -193,8 +189,8 @@ bool WriteTimingsJson(const std::string& path,
   Json timings = Json::object(), cpu = Json::object(),
        iterations = Json::object();
   for (const StageTiming& timing : summary.timings) {
-    timings[timing.stage] = Number(timing.seconds);
-    cpu[timing.stage] = Number(timing.cpu_seconds);
+    timings[timing.stage] = JsonNumber(timing.seconds);
+    cpu[timing.stage] = JsonNumber(timing.cpu_seconds);
     if (timing.num_iterations > 0) {
       iterations[timing.stage] = timing.num_iterations;
     }

@@ -6,18 +6,12 @@
 #include <sstream>
 
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/binary_bytes.h"
 #include "colmap_ext/io/colmap_camera_models.h"
 #include "colmap_ext/io/number_text.h"
 
 namespace rig_calibrator {
 namespace {
-
-template <typename T>
-void AppendBinary(const T value, std::string* bytes) {
-  char buffer[sizeof(T)];
-  std::memcpy(buffer, &value, sizeof(T));
-  bytes->append(buffer, sizeof(T));
-}
 
 bool ReadBinaryRecords(const std::string& path,
                        std::vector<CameraRecord>* cameras, std::string* error) {

@@ -1,15 +1,11 @@
 #include "colmap_ext/io/coverage_json.h"
 
-#include <cmath>
+#include "colmap_ext/io/json_number.h"
 
 namespace rig_calibrator {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-Json Number(const double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
 
 }  // namespace
 
@@ -21,10 +17,10 @@ void AddCoverageJson(const CameraSummary& camera, Json* node) {
          {{"cols", coverage.grid_cols},
           {"rows", coverage.grid_rows},
           {"counts", coverage.counts}}},
-        {"fraction_cells", Number(coverage.fraction_cells)},
-        {"max_observed_radius_px", Number(coverage.max_observed_radius_px)},
-        {"corner_radius_px", Number(coverage.corner_radius_px)},
-        {"radius_ratio", Number(coverage.radius_ratio)}};
+        {"fraction_cells", JsonNumber(coverage.fraction_cells)},
+        {"max_observed_radius_px", JsonNumber(coverage.max_observed_radius_px)},
+        {"corner_radius_px", JsonNumber(coverage.corner_radius_px)},
+        {"radius_ratio", JsonNumber(coverage.radius_ratio)}};
   }
   if (camera.refined) {
     (*node)["refined"] = {{"focal_length", camera.refined->focal_length},

@@ -11,6 +11,7 @@
 #include <unordered_set>
 
 #include "colmap_ext/io/atomic_output.h"
+#include "colmap_ext/io/binary_bytes.h"
 #include "colmap_ext/io/map_reader.h"
 #include "colmap_ext/io/name_table.h"
 #include "colmap_ext/io/number_text.h"
@@ -42,15 +43,6 @@ void WritePoseText(const Rigid3d& pose, std::ostream* stream) {
           << pose.rotation.y() << " " << pose.rotation.z() << " "
           << pose.translation.x() << " " << pose.translation.y() << " "
           << pose.translation.z();
-}
-
-template <typename T>
-void AppendBinary(T value, std::string* bytes) {
-  static_assert(std::is_arithmetic<T>::value, "plain numbers only");
-  // The formats are little endian, as is every platform COLMAP runs on.
-  char buffer[sizeof(T)];
-  std::memcpy(buffer, &value, sizeof(T));
-  bytes->append(buffer, sizeof(T));
 }
 
 void AppendPoseBinary(const Rigid3d& pose, std::string* bytes) {

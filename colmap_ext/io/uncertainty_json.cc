@@ -4,35 +4,32 @@
 #include <iomanip>
 #include <sstream>
 
+#include "colmap_ext/io/json_number.h"
+
 namespace rig_calibrator {
 namespace {
 
 using Json = nlohmann::ordered_json;
 
-// JSON has no NaN: an undetermined value is null.
-Json Number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
 Json Vector(const Eigen::Vector3d& value) {
-  return Json::array({Number(value.x()), Number(value.y()), Number(value.z())});
+  return Json::array({JsonNumber(value.x()), JsonNumber(value.y()), JsonNumber(value.z())});
 }
 
 Json CameraJson(const CalibrationUncertainty& uncertainty,
                 const CameraUncertainty& camera) {
   Json node;
-  node["residual_scale_px"] = Number(uncertainty.residual_scale_px);
+  node["residual_scale_px"] = JsonNumber(uncertainty.residual_scale_px);
   node["determined"] = camera.determined;
   node["params_stddev"] = Json::array();
   for (const double stddev : camera.params_stddev) {
-    node["params_stddev"].push_back(Number(stddev));
+    node["params_stddev"].push_back(JsonNumber(stddev));
   }
-  node["rotation_stddev_deg"] = Number(camera.rotation_stddev_deg);
+  node["rotation_stddev_deg"] = JsonNumber(camera.rotation_stddev_deg);
   node["rotation_axis_stddev_deg"] = Vector(camera.rotation_axis_stddev_deg);
   node["translation_stddev"] = Vector(camera.translation_stddev);
   node["center_in_rig_stddev"] = Vector(camera.center_in_rig_stddev);
   node["between_framesets_factor"] =
-      uncertainty.num_clusters > 0 ? Number(camera.between_framesets_factor)
+      uncertainty.num_clusters > 0 ? JsonNumber(camera.between_framesets_factor)
                                    : Json(nullptr);
   const ProjectionUncertainty& projection = camera.projection;
   if (projection.stddev_px.empty()) {
@@ -41,13 +38,13 @@ Json CameraJson(const CalibrationUncertainty& uncertainty,
   }
   Json values = Json::array();
   for (const double value : projection.stddev_px)
-    values.push_back(Number(value));
+    values.push_back(JsonNumber(value));
   node["projection_stddev_px"] = {
-      {"median", Number(projection.median_px)},
-      {"max", Number(projection.max_px)},
-      {"max_at", Json::array({Number(projection.max_at.x()),
-                              Number(projection.max_at.y())})},
-      {"depth", Number(projection.depth)},
+      {"median", JsonNumber(projection.median_px)},
+      {"max", JsonNumber(projection.max_px)},
+      {"max_at", Json::array({JsonNumber(projection.max_at.x()),
+                              JsonNumber(projection.max_at.y())})},
+      {"depth", JsonNumber(projection.depth)},
       {"grid",
        {{"cols", projection.cols},
         {"rows", projection.rows},

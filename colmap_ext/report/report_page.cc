@@ -27,8 +27,6 @@ namespace {
 constexpr double kOutlyingFramesetFactor = 2;
 constexpr size_t kNumWorstRows = 10;
 
-std::string Escape(const std::string& text) { return XmlEscape(text); }
-
 const char kStyle[] = R"(
 body { font-family: sans-serif; margin: 1.5em; color: #222; max-width: 1500px; }
 h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; margin-top: 1.6em; }
@@ -76,7 +74,7 @@ struct Page {
   void MissingFigure(const std::string& id, const std::string& title,
                      const std::string& reason) {
     html << "<figure id=\"fig-" << id << "\" class=\"missing\"><p><b>"
-         << Escape(title) << "</b>: " << NotComputedHtml(reason)
+         << XmlEscape(title) << "</b>: " << NotComputedHtml(reason)
          << "</p></figure>\n";
   }
 };
@@ -136,23 +134,23 @@ void OverviewSection(const ReportInputs& inputs, Page* page) {
   const ReportJson* metric = FindKey(summary, "map_looks_metric");
   std::ostringstream& html = page->html;
   html << "<section id=\"overview\"><h2>Overview</h2><table>"
-       << "<tr><th>method</th><td>" << Escape(TextAt(summary, "method"))
+       << "<tr><th>method</th><td>" << XmlEscape(TextAt(summary, "method"))
        << "</td></tr><tr><th>seed</th><td>"
        << FormatNumber(NumberAt(summary, "seed"), 10)
-       << "</td></tr><tr><th>units</th><td>" << Escape(TextAt(summary, "units"))
+       << "</td></tr><tr><th>units</th><td>" << XmlEscape(TextAt(summary, "units"))
        << (metric != nullptr && metric->is_boolean()
                ? (metric->get<bool>() ? " (the map looks metric)"
                                       : " (the map does not look metric)")
                : "")
        << "</td></tr><tr><th>reference camera</th><td>"
-       << Escape(TextAt(summary, "reference_camera"))
+       << XmlEscape(TextAt(summary, "reference_camera"))
        << "</td></tr><tr><th>framesets with a rig pose</th><td>"
        << FormatNumber(NumberAt(summary, "num_framesets_used"), 9) << " of "
        << FormatNumber(NumberAt(summary, "num_framesets"), 9)
        << "</td></tr><tr><th>uncertainty method</th><td>";
   const std::string method = TextAt(summary, "uncertainty_method");
   html << (method.empty() ? NotComputedHtml("no \"uncertainty_method\"")
-                          : Escape(method))
+                          : XmlEscape(method))
        << "</td></tr>";
   if (const ReportJson* map = FindKey(summary, "map_images")) {
     html << "<tr><th>map images: mean reprojection error input \u2192 "
@@ -164,12 +162,12 @@ void OverviewSection(const ReportInputs& inputs, Page* page) {
   }
   html << "</table>\n";
   if (const ReportJson* known = FindKey(summary, "known_rig")) {
-    html << "<p>Against the known rig of " << Escape(TextAt(*known, "source"))
+    html << "<p>Against the known rig of " << XmlEscape(TextAt(*known, "source"))
          << ":</p><table><tr><th>camera</th><th>rotation error (deg)</th>"
             "<th>translation error</th></tr>";
     if (const ReportJson* cameras = FindKey(*known, "cameras")) {
       for (const ReportJson& camera : *cameras) {
-        html << "<tr><td>" << Escape(TextAt(camera, "name")) << "</td><td>"
+        html << "<tr><td>" << XmlEscape(TextAt(camera, "name")) << "</td><td>"
              << FormatNumber(NumberAt(camera, "rotation_error_deg"))
              << "</td><td>"
              << FormatNumber(NumberAt(camera, "translation_error"))
@@ -188,7 +186,7 @@ void CameraSection(const ReportJson& camera, const int index,
   const ReportJson* calibrated = FindKey(camera, "calibrated");
   std::ostringstream& html = page->html;
   html << "<section class=\"camera\" id=\"camera-" << i << "\"><h3>"
-       << Escape(name) << " (" << Escape(TextAt(camera, "model")) << ", "
+       << XmlEscape(name) << " (" << XmlEscape(TextAt(camera, "model")) << ", "
        << FormatNumber(NumberAt(camera, "width"), 6) << " \u00d7 "
        << FormatNumber(NumberAt(camera, "height"), 6) << ")</h3>\n";
   const std::optional<colmap::Camera> model = SummaryCamera(camera);
@@ -272,7 +270,7 @@ void CameraSection(const ReportJson& camera, const int index,
         FormatNumber(corner_radius) + " px. Grey: no inlier.";
   }
   page->Figure("coverage-" + i, HeatMapSvg(coverage_options, *counts),
-               Escape(coverage_caption));
+               XmlEscape(coverage_caption));
 
   // Projection uncertainty.
   const ReportJson* uncertainty = FindKey(camera, "uncertainty");
@@ -299,7 +297,7 @@ void CameraSection(const ReportJson& camera, const int index,
     }
     page->Figure(
         "uncertainty-" + i, HeatMapSvg(options, *stddevs),
-        Escape("1\u03c3 uncertainty of the projection of a ray, per cell "
+        XmlEscape("1\u03c3 uncertainty of the projection of a ray, per cell "
                "centre: median " +
                FormatNumber(NumberAt(*projection, "median")) + " px, max " +
                FormatNumber(NumberAt(*projection, "max")) + " px (circled)."));
@@ -317,7 +315,7 @@ void CameraSection(const ReportJson& camera, const int index,
   profile.max_observed_radius_px = residuals.max_radius_px;
   page->Figure(
       "distortion-" + i, DistortionProfileSvg(profile, *model),
-      Escape("Angle of a ray from the optical axis against where the model "
+      XmlEscape("Angle of a ray from the optical axis against where the model "
              "images it, towards the farthest corner (COLMAP's model). "
              "Observed radii " +
              FormatNumber(residuals.min_radius_px) + " to " +
@@ -369,7 +367,7 @@ void RigSection(const ReportJson& summary, Page* page) {
       }
       caption += ".";
     }
-    page->Figure(id, figure.svg, Escape(caption));
+    page->Figure(id, figure.svg, XmlEscape(caption));
   }
   html << "</div></section>\n";
 }
@@ -404,7 +402,7 @@ void FramesetsSection(const ModelResiduals& residuals,
   html << "<table id=\"worst-framesets\"><tr><th>frameset</th><th>index</th>"
           "<th>observations</th><th>RMS (px)</th>";
   for (const std::string& name : camera_names) {
-    html << "<th>" << Escape(name) << "</th>";
+    html << "<th>" << XmlEscape(name) << "</th>";
   }
   html << "</tr>\n";
   for (size_t k = 0; k < std::min(kNumWorstRows, order.size()); ++k) {
@@ -412,7 +410,7 @@ void FramesetsSection(const ModelResiduals& residuals,
     const bool bad =
         std::find(outlying.begin(), outlying.end(), order[k]) != outlying.end();
     html << (bad ? "<tr class=\"bad\">" : "<tr>") << "<td>"
-         << Escape(frameset.name) << "</td><td>" << order[k] << "</td><td>"
+         << XmlEscape(frameset.name) << "</td><td>" << order[k] << "</td><td>"
          << frameset.num_observations << "</td><td>"
          << FormatNumber(frameset.rms_px) << "</td>";
     for (const double rms : frameset.camera_rms_px) {
@@ -430,8 +428,8 @@ void FramesetsSection(const ModelResiduals& residuals,
   });
   for (size_t k = 0; k < std::min(kNumWorstRows, images.size()); ++k) {
     const ImageError& image = residuals.images[images[k]];
-    html << "<tr><td>" << Escape(image.name) << "</td><td>"
-         << Escape(camera_names[image.camera]) << "</td><td>" << image.frameset
+    html << "<tr><td>" << XmlEscape(image.name) << "</td><td>"
+         << XmlEscape(camera_names[image.camera]) << "</td><td>" << image.frameset
          << "</td><td>" << image.num_observations << "</td><td>"
          << FormatNumber(image.rms_px) << "</td></tr>\n";
   }
@@ -495,7 +493,7 @@ bool BuildReportHtml(const ReportInputs& inputs, std::string* html,
     } else {
       page.html << "<details><summary>Kalibr-style camchain.yaml (as "
                    "written)</summary><pre>"
-                << Escape(inputs.camchain_yaml) << "</pre></details>";
+                << XmlEscape(inputs.camchain_yaml) << "</pre></details>";
     }
     page.html << "</section>\n<script>" << kSelfCheckScript
               << "</script>\n</body></html>\n";

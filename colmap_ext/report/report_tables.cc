@@ -10,8 +10,6 @@
 namespace rig_calibrator {
 namespace {
 
-std::string Escape(const std::string& text) { return XmlEscape(text); }
-
 // COLMAP's parameter names of a model ("fx", "cx", "k1", ...); p0, p1, ...
 // for a model COLMAP 3.8 does not know.
 std::vector<std::string> ParamNames(const std::string& model, size_t count) {
@@ -61,7 +59,7 @@ std::string Vector3Html(const std::optional<Eigen::Vector3d>& value,
 std::string NotComputedHtml(const std::string& reason) {
   return "<span class=\"not-computed\">not computed</span> <span "
          "class=\"why\">(" +
-         Escape(reason) + ")</span>";
+         XmlEscape(reason) + ")</span>";
 }
 
 std::optional<Eigen::Vector3d> Vector3At(const ReportJson& node,
@@ -138,7 +136,7 @@ std::string IntrinsicsTableHtml(const ReportJson& summary) {
       std::string& cell = cells[group[k]];
       if (!cell.empty()) cell += "<br/>";
       cell +=
-          Escape(names[k]) + " " + WithStddev(NumberOr(&(*params)[k]), stddev);
+          XmlEscape(names[k]) + " " + WithStddev(NumberOr(&(*params)[k]), stddev);
     }
     if (stddevs == nullptr) {
       cells[0] += "<br/>\u03c3: " + NotComputedHtml("no \"uncertainty\"");
@@ -157,8 +155,8 @@ std::string IntrinsicsTableHtml(const ReportJson& summary) {
                              : "\u2013");
       }
     }
-    html << "<tr>" << Cell(Escape(TextAt(camera, "name")))
-         << Cell(Escape(model))
+    html << "<tr>" << Cell(XmlEscape(TextAt(camera, "name")))
+         << Cell(XmlEscape(model))
          << Cell(FormatNumber(NumberAt(camera, "width"), 6) + " \u00d7 " +
                  FormatNumber(NumberAt(camera, "height"), 6))
          << Cell(cells[0]) << Cell(cells[1])
@@ -189,7 +187,7 @@ std::string PosesTableHtml(const ReportJson& summary) {
     if (rotation && translation) {
       center = -(rotation->inverse() * *translation);
     }
-    html << "<tr>" << Cell(Escape(TextAt(camera, "name")));
+    html << "<tr>" << Cell(XmlEscape(TextAt(camera, "name")));
     if (!rotation || !translation) {
       html << "<td colspan=\"3\">not calibrated</td>";
     } else {
@@ -227,9 +225,9 @@ std::string ModelChoiceHtml(const ReportJson& summary) {
                              : 0;
     const std::string span =
         "<td rowspan=\"" + std::to_string(std::max<size_t>(1, count)) + "\">";
-    rows << "<tr>" << span << Escape(TextAt(camera, "name")) << "</td>" << span
-         << "<b>" << Escape(TextAt(*choice, "chosen"))
-         << "</b>: " << Escape(TextAt(*choice, "reason")) << "</td>";
+    rows << "<tr>" << span << XmlEscape(TextAt(camera, "name")) << "</td>" << span
+         << "<b>" << XmlEscape(TextAt(*choice, "chosen"))
+         << "</b>: " << XmlEscape(TextAt(*choice, "reason")) << "</td>";
     if (count == 0) rows << "<td colspan=\"6\">no candidates</td></tr>\n";
     for (size_t k = 0; k < count; ++k) {
       const ReportJson& candidate = (*candidates)[k];
@@ -239,7 +237,7 @@ std::string ModelChoiceHtml(const ReportJson& summary) {
           chosen != nullptr && chosen->is_boolean() && chosen->get<bool>();
       if (k > 0) rows << "<tr>";
       rows << Cell(std::string(is_chosen ? "<b class=\"chosen\">" : "") +
-                   Escape(TextAt(candidate, "model")) +
+                   XmlEscape(TextAt(candidate, "model")) +
                    (is_chosen ? " \u2714</b>" : ""))
            << Cell(valid != nullptr && valid->is_boolean()
                        ? (valid->get<bool>() ? "yes" : "no")
@@ -271,7 +269,7 @@ std::string ValidityTableHtml(const ReportJson& summary) {
           "</th><th>fold radius (px)</th><th>corner radius "
           "(px)</th><th>suggested model</th><th>message</th></tr>\n";
   for (const ReportJson& camera : Cameras(summary)) {
-    html << "<tr>" << Cell(Escape(TextAt(camera, "name")));
+    html << "<tr>" << Cell(XmlEscape(TextAt(camera, "name")));
     const ReportJson* validity = FindKey(camera, "validity");
     if (validity == nullptr) {
       html << "<td colspan=\"8\">"
@@ -290,8 +288,8 @@ std::string ValidityTableHtml(const ReportJson& summary) {
          << Cell(yes_no("fits_data"))
          << Cell(FormatNumber(NumberAt(*validity, "fold_radius_px")))
          << Cell(FormatNumber(NumberAt(*validity, "corner_radius_px")))
-         << Cell(suggested.empty() ? "\u2013" : Escape(suggested))
-         << Cell(Escape(TextAt(*validity, "message"))) << "</tr>\n";
+         << Cell(suggested.empty() ? "\u2013" : XmlEscape(suggested))
+         << Cell(XmlEscape(TextAt(*validity, "message"))) << "</tr>\n";
   }
   html << "</table>\n";
   return html.str();
@@ -313,7 +311,7 @@ std::string DiagnosticsListHtml(const ReportJson& summary) {
       if (text.rfind(std::string(name) + " ", 0) == 0) level = name;
     }
     html << "<li class=\"" << level << "\"><b>" << level << "</b> "
-         << Escape(level == "note" ? text : text.substr(level.size() + 1))
+         << XmlEscape(level == "note" ? text : text.substr(level.size() + 1))
          << "</li>\n";
   }
   html << "</ul>\n";

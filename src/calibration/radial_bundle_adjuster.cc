@@ -26,7 +26,7 @@ constexpr int kMinInliersPerImage = 5;
 constexpr double kMinInlierShare = 0.5;
 
 // One correspondence in the adjustment.
-struct Observation {
+struct RadialObservation {
   int image;  // dataset image index
   int camera;
   int frameset;
@@ -42,7 +42,7 @@ struct Parameters {
 };
 
 // |pi_r(...) - (x - c)|: the radial reprojection error of an observation.
-double RadialError(const Observation& observation,
+double RadialError(const RadialObservation& observation,
                    const Parameters& parameters) {
   const double* blocks[] = {
       parameters.cam_from_rig[observation.camera].data(),
@@ -54,11 +54,11 @@ double RadialError(const Observation& observation,
   return std::hypot(residual[0], residual[1]);
 }
 
-double RmsRadialError(const std::vector<Observation>& observations,
+double RmsRadialError(const std::vector<RadialObservation>& observations,
                       const Parameters& parameters) {
   if (observations.empty()) return 0;
   double sum_sq = 0;
-  for (const Observation& observation : observations) {
+  for (const RadialObservation& observation : observations) {
     const double error = RadialError(observation, parameters);
     sum_sq += error * error;
   }
@@ -69,13 +69,13 @@ double RmsRadialError(const std::vector<Observation>& observations,
 // (AxesDetermineTranslation over the principal axes, in the rig frame, of the
 // cameras observing it: parallel and anti-parallel axes do not); only
 // cameras with kMinInliersPerImage observations in the frameset count.
-std::vector<Observation> KeepDeterminedFramesets(
-    const std::vector<Observation>& observations,
+std::vector<RadialObservation> KeepDeterminedFramesets(
+    const std::vector<RadialObservation>& observations,
     const RigCalibration& calibration) {
   const int num_framesets = calibration.rig_from_world.size();
   std::vector<std::vector<int>> count_of_camera(
       num_framesets, std::vector<int>(calibration.cam_from_rig.size(), 0));
-  for (const Observation& observation : observations) {
+  for (const RadialObservation& observation : observations) {
     ++count_of_camera[observation.frameset][observation.camera];
   }
   std::vector<char> determined(num_framesets, 0);
@@ -88,8 +88,8 @@ std::vector<Observation> KeepDeterminedFramesets(
     }
     determined[j] = AxesDetermineTranslation(axes);
   }
-  std::vector<Observation> kept;
-  for (const Observation& observation : observations) {
+  std::vector<RadialObservation> kept;
+  for (const RadialObservation& observation : observations) {
     if (determined[observation.frameset]) kept.push_back(observation);
   }
   return kept;
@@ -106,13 +106,13 @@ std::vector<Observation> KeepDeterminedFramesets(
 // cam_from_rig and principal point are one block row.
 BundleSolverSummary Solve(
     const RadialBundleAdjustmentOptions& options,
-    const std::vector<Observation>& observations, int reference_camera,
+    const std::vector<RadialObservation>& observations, int reference_camera,
     const std::vector<RigCamera>& cameras, Parameters* parameters) {
   const int num_cameras = parameters->cam_from_rig.size();
   const int num_framesets = parameters->rig_from_world.size();
   std::vector<char> cam_added(num_cameras, 0);
   std::vector<char> rig_added(num_framesets, 0);
-  for (const Observation& observation : observations) {
+  for (const RadialObservation& observation : observations) {
     cam_added[observation.camera] = 1;
     rig_added[observation.frameset] = 1;
   }
@@ -171,7 +171,7 @@ BundleSolverSummary Solve(
   }
   solver.Reserve(observations.size(), 0);
   for (int64_t k = 0; k < num_observations; ++k) {
-    const Observation& observation = observations[k];
+    const RadialObservation& observation = observations[k];
     solver.AddResidualBlock(
         costs[k].get(), &loss,
         {parameters->cam_from_rig[observation.camera].data(),
@@ -184,9 +184,9 @@ BundleSolverSummary Solve(
   return summary;
 }
 
-bool ObservesReference(const std::vector<Observation>& observations,
+bool ObservesReference(const std::vector<RadialObservation>& observations,
                        int reference_camera) {
-  for (const Observation& observation : observations) {
+  for (const RadialObservation& observation : observations) {
     if (observation.camera == reference_camera) return true;
   }
   return false;
@@ -262,10 +262,10 @@ std::string CheckInput(const RigDataset& dataset,
 // Inlier correspondences of the images of calibrated cameras in posed
 // framesets; per image at most max_per_image (0: all), the k-th of m taken
 // at inlier floor(k * n / m) of n.
-std::vector<Observation> InlierObservations(const RigDataset& dataset,
+std::vector<RadialObservation> InlierObservations(const RigDataset& dataset,
                                             const RigCalibration& calibration,
                                             int max_per_image) {
-  std::vector<Observation> observations;
+  std::vector<RadialObservation> observations;
   for (size_t k = 0; k < dataset.images.size(); ++k) {
     const RigImage& image = dataset.images[k];
     const std::vector<char>& mask = calibration.images[k].inlier_mask;
@@ -313,8 +313,8 @@ Parameters ParametersOf(const RigCalibration& calibration) {
 
 // The observations within max_error of the solution whose image has at
 // least kMinInlierShare of its observations within it (see AdjustRadialRig).
-std::vector<Observation> KeepInliers(
-    const std::vector<Observation>& observations, const Parameters& parameters,
+std::vector<RadialObservation> KeepInliers(
+    const std::vector<RadialObservation>& observations, const Parameters& parameters,
     int num_images, double max_error) {
   std::vector<char> within(observations.size(), 0);
   std::vector<int> num_selected(num_images, 0);
@@ -324,7 +324,7 @@ std::vector<Observation> KeepInliers(
     ++num_selected[observations[n].image];
     num_within[observations[n].image] += within[n];
   }
-  std::vector<Observation> inliers;
+  std::vector<RadialObservation> inliers;
   for (size_t n = 0; n < observations.size(); ++n) {
     const int image = observations[n].image;
     if (within[n] &&
@@ -337,14 +337,14 @@ std::vector<Observation> KeepInliers(
 
 // Writes back what the final solve adjusted (tz = 0, the reference camera
 // the identity). Returns the number of rig poses it did not adjust.
-int WriteAdjusted(const std::vector<Observation>& observations,
+int WriteAdjusted(const std::vector<RadialObservation>& observations,
                   const Parameters& parameters, int reference,
                   RigCalibration* calibration) {
   const int num_cameras = calibration->cam_from_rig.size();
   const int num_framesets = calibration->rig_from_world.size();
   std::vector<char> cam_adjusted(num_cameras, 0);
   std::vector<char> rig_adjusted(num_framesets, 0);
-  for (const Observation& observation : observations) {
+  for (const RadialObservation& observation : observations) {
     cam_adjusted[observation.camera] = 1;
     rig_adjusted[observation.frameset] = 1;
   }
@@ -389,7 +389,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
         summary);
   }
   const int reference = dataset.reference_camera;
-  std::vector<Observation> observations = KeepDeterminedFramesets(
+  std::vector<RadialObservation> observations = KeepDeterminedFramesets(
       InlierObservations(dataset, *calibration,
                          options.max_correspondences_per_image),
       *calibration);
@@ -416,7 +416,7 @@ bool AdjustRadialRig(const RadialBundleAdjustmentOptions& options,
                        solver_summary.num_unsuccessful_steps;
   int num_outliers = 0;
   if (solver_summary.IsSolutionUsable() && options.max_radial_error_px > 0) {
-    const std::vector<Observation> inliers =
+    const std::vector<RadialObservation> inliers =
         KeepInliers(observations, parameters, dataset.images.size(),
                     options.max_radial_error_px);
     num_outliers = observations.size() - inliers.size();

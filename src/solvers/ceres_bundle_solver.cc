@@ -10,7 +10,7 @@
 namespace rig_calibrator {
 namespace {
 
-double Seconds(std::chrono::steady_clock::time_point start) {
+double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
       .count();
 }
@@ -110,7 +110,7 @@ void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
   summary->num_points = static_cast<int>(
       std::count_if(point_held_.begin(), point_held_.end(),
                     [](const auto& point) { return !point.second; }));
-  const double build_seconds = Seconds(start_time);
+  const double build_seconds = SecondsSince(start_time);
 
   ceres::Solver::Options solver_options;
   solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -151,7 +151,7 @@ void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
       ceres_summary.residual_evaluation_time_in_seconds +
       ceres_summary.jacobian_evaluation_time_in_seconds;
   summary->factorization_seconds = ceres_summary.linear_solver_time_in_seconds;
-  summary->seconds = Seconds(start_time);
+  summary->seconds = SecondsSince(start_time);
 }
 
 }  // namespace rig_calibrator

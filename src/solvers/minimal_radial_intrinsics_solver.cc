@@ -28,7 +28,7 @@ constexpr double kEquidistantScanRange = 9.2;  // ln(1e4)
 // Root and minimum searches of the scan.
 constexpr std::uintmax_t kMaxNumBracketIterations = 100;
 // Newton steps after the root finding (2-3 reach machine precision).
-constexpr int kMaxNumPolishIterations = 8;
+constexpr int kMaxNumNewtonPolishIterations = 8;
 // A polished root is a solution when the RMS radial residual of the sample
 // is below this fraction of its RMS radius.
 constexpr double kMaxRelativeResidual = 1e-6;
@@ -285,7 +285,7 @@ std::vector<RadialIntrinsics> SolveMinimalRadialIntrinsics(
     model.tz = v * sample.length - sample.mean_c;
     double squared_error = 0;
     if (RefineRadialProfileAndTz(x, points_cam, known_focal,
-                                 kMaxNumPolishIterations, &model,
+                                 kMaxNumNewtonPolishIterations, &model,
                                  &squared_error) &&
         squared_error <= max_squared_error &&
         RadiusGrowsOverPoints(x, points_cam, model)) {

@@ -28,7 +28,7 @@ constexpr size_t kMaxNumCandidates = 3;
 constexpr int kBrentBits = std::numeric_limits<double>::digits / 2;
 constexpr std::uintmax_t kMaxNumBrentIterations = 100;
 // Gauss-Newton steps after Brent (2-3 reach machine precision on exact data).
-constexpr int kMaxNumPolishIterations = 5;
+constexpr int kMaxNumGaussNewtonPolishIterations = 5;
 
 // E(tz) of the variable projection; infinite where FitRadialProfile fails.
 double ProfileError(const std::vector<Eigen::Vector2d>& x,
@@ -127,7 +127,7 @@ std::vector<RadialIntrinsics> SolveRadialIntrinsicsLeastSquares(
     candidate.tz = tz_of_exponent(exponent);
     double squared_error = 0;
     if (RefineRadialProfileAndTz(x, points_cam, known_focal,
-                                 kMaxNumPolishIterations, &candidate,
+                                 kMaxNumGaussNewtonPolishIterations, &candidate,
                                  &squared_error) &&
         RadiusGrowsOverPoints(x, points_cam, candidate)) {
       candidates.emplace_back(squared_error, candidate);

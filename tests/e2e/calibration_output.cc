@@ -107,6 +107,8 @@ Summary ReadSummary(const std::string& path) {
   return summary;
 }
 
+}  // namespace
+
 colmap::Reconstruction ReadModel(const std::string& folder) {
   colmap::Reconstruction model;
   if (fs::exists(folder + "/cameras.bin")) {
@@ -118,8 +120,6 @@ colmap::Reconstruction ReadModel(const std::string& folder) {
   }
   return model;
 }
-
-}  // namespace
 
 Output ReadOutput(const std::string& folder) {
   if (!fs::is_directory(folder)) Die("no output folder " + folder);

@@ -59,6 +59,10 @@ struct Output {
   Summary summary;
 };
 
+// Reads the COLMAP model (binary or text) in `folder`; exits (Die) if there
+// is none.
+colmap::Reconstruction ReadModel(const std::string& folder);
+
 // Reads the model and calibration_summary.json of an output folder; exits
 // (Die) if they cannot be read.
 Output ReadOutput(const std::string& folder);

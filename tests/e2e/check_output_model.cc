@@ -16,7 +16,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -45,17 +44,6 @@ double ReprojectionError(const colmap::Reconstruction& model,
   return (model.Camera(image.CameraId()).WorldToImage(in_camera.hnormalized()) -
           point2D.XY())
       .norm();
-}
-
-colmap::Reconstruction ReadModel(const std::string& folder) {
-  colmap::Reconstruction model;
-  const std::string binary = folder + "/images.bin";
-  if (!std::ifstream(binary).good() &&
-      !std::ifstream(folder + "/images.txt").good()) {
-    Die("no COLMAP model in " + folder);
-  }
-  model.Read(folder);
-  return model;
 }
 
 void CheckMeanError(const colmap::Reconstruction& model) {

@@ -7,7 +7,7 @@
 #include <string>
 
 namespace rig_calibrator {
-namespace {
+namespace colmap_rig_ba_comparison_test {
 
 // What COLMAP 3.8 rig_bundle_adjuster prints (src/exe/sfm.cc and
 // PrintSolverSummary), shortened.
@@ -148,5 +148,5 @@ TEST(RunColmapRigBaComparison, NamesTheBadOption) {
       << error;
 }
 
-}  // namespace
+}  // namespace colmap_rig_ba_comparison_test
 }  // namespace rig_calibrator

@@ -6,7 +6,7 @@
 #include <sstream>
 
 namespace rig_calibrator {
-namespace {
+namespace runtime_benchmark_test {
 
 CalibrationRuntime MakeRun(int num_framesets, int num_cameras,
                            double cpu_seconds) {
@@ -260,5 +260,5 @@ TEST(RuntimeBenchmark, SvgHasTwoSeriesPerCameraCount) {
   EXPECT_NE(svg.find("framesets"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace runtime_benchmark_test
 }  // namespace rig_calibrator

@@ -8,7 +8,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace synthetic_map_database_test {
 
 SyntheticMapDatabaseOptions SmallOptions() {
   SyntheticMapDatabaseOptions options;
@@ -143,5 +143,5 @@ TEST_F(SyntheticMapDatabaseTest,
   }
 }
 
-}  // namespace
+}  // namespace synthetic_map_database_test
 }  // namespace rig_calibrator

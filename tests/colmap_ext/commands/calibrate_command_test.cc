@@ -22,7 +22,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace calibrate_command_test {
 
 namespace fs = std::filesystem;
 
@@ -462,5 +462,5 @@ TEST_F(CalibrateCommandBadInput, NonColmapFilesAsModel) {
                                 "pose that is not finite"});
 }
 
-}  // namespace
+}  // namespace calibrate_command_test
 }  // namespace rig_calibrator

@@ -23,7 +23,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace camera_model_command_test {
 
 namespace fs = boost::filesystem;
 
@@ -202,5 +202,5 @@ TEST_F(CameraModelCommandTest, AutoChoosesFisheyeAsAccurateAsByHand) {
   }
 }
 
-}  // namespace
+}  // namespace camera_model_command_test
 }  // namespace rig_calibrator

@@ -34,7 +34,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace colmap_4_1_1_calibration_test {
 
 namespace fs = std::filesystem;
 
@@ -308,5 +308,5 @@ TEST_F(Colmap411CalibrationTest, FramesAndKnownPosesFromTheDatabase) {
   EXPECT_EQ(num_fisheye, 1);
 }
 
-}  // namespace
+}  // namespace colmap_4_1_1_calibration_test
 }  // namespace rig_calibrator

@@ -7,7 +7,7 @@
 #include <string>
 
 namespace rig_calibrator {
-namespace {
+namespace colmap_help_test {
 
 const char kParagraph[] =
     "Added by rig_calibrator (multi-camera rig calibration; the commands "
@@ -65,5 +65,5 @@ TEST(ExtendColmapHelp, TextWithoutTheListGetsBothAtTheEnd) {
             std::string("colmap\n  rig_calibrator\n\n") + kParagraph);
 }
 
-}  // namespace
+}  // namespace colmap_help_test
 }  // namespace rig_calibrator

@@ -20,7 +20,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace colmap_main_test {
 
 struct Output {
   int exit_code = -1;
@@ -314,5 +314,5 @@ TEST(ColmapMain, RigCalibratorEvaluateWritesTheSameErrors) {
   EXPECT_EQ(testing::ReadBytes(temp.File("extended.json")), bytes);
 }
 
-}  // namespace
+}  // namespace colmap_main_test
 }  // namespace rig_calibrator

@@ -23,7 +23,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace commands_test {
 
 namespace fs = boost::filesystem;
 
@@ -376,5 +376,5 @@ TEST(Evaluate, MissingFilesFail) {
   EXPECT_EQ(RunCommand(&RunEvaluate, {}), EXIT_FAILURE);
 }
 
-}  // namespace
+}  // namespace commands_test
 }  // namespace rig_calibrator

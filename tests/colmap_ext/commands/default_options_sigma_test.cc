@@ -36,7 +36,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace default_options_sigma_test {
 
 struct Group {
   std::vector<double> z;
@@ -192,5 +192,5 @@ TEST(DefaultOptionsSigma, ErrorsOverSigmaOnMapsLikeSfM) {
   std::printf("\n");
 }
 
-}  // namespace
+}  // namespace default_options_sigma_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include <unordered_map>
 
 namespace rig_calibrator {
-namespace {
+namespace guarded_run_test {
 
 // Runs `command` through RunGuarded; returns its exit code and stderr.
 std::pair<int, std::string> Guarded(const std::function<int()>& command) {
@@ -53,5 +53,5 @@ TEST(RunGuarded, ExceptionOfAnyTypeBecomesOneErrorLine) {
       << messages;
 }
 
-}  // namespace
+}  // namespace guarded_run_test
 }  // namespace rig_calibrator

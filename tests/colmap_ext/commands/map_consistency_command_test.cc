@@ -22,7 +22,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_consistency_command_test {
 
 namespace fs = std::filesystem;
 
@@ -216,5 +216,5 @@ TEST_F(MapConsistencyCommand, CameraWithNegativeFocalLengthIsRefused) {
   EXPECT_FALSE(fs::exists(output_));
 }
 
-}  // namespace
+}  // namespace map_consistency_command_test
 }  // namespace rig_calibrator

@@ -22,7 +22,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace refinement_switches_test {
 
 namespace fs = boost::filesystem;
 
@@ -215,5 +215,5 @@ TEST_F(RefinementSwitchesTest, BadSwitchesAreRefused) {
   }
 }
 
-}  // namespace
+}  // namespace refinement_switches_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/colmap_ext/report/report_testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace report_command_test {
 
 int RunReportCommand(const std::vector<std::string>& arguments) {
   std::vector<std::string> args = {"rig_calibrator report"};
@@ -56,5 +56,5 @@ TEST(ReportCommand, BadFolderIsAnErrorNamingIt) {
             std::string::npos);
 }
 
-}  // namespace
+}  // namespace report_command_test
 }  // namespace rig_calibrator

@@ -11,7 +11,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace atomic_output_test {
 
 namespace fs = std::filesystem;
 
@@ -239,5 +239,5 @@ TEST(AtomicOutput, OutputMustNotOverlapInputs) {
       << error;
 }
 
-}  // namespace
+}  // namespace atomic_output_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace calibration_summary_test {
 
 Rigid3d Pose(const double angle, const Eigen::Vector3d& axis,
              const Eigen::Vector3d& translation) {
@@ -104,5 +104,5 @@ TEST(CompareWithKnownRig, NothingWithoutAPriorOrACalibratedReference) {
   EXPECT_TRUE(nlohmann::json::parse(file)["known_rig"].is_null());
 }
 
-}  // namespace
+}  // namespace calibration_summary_test
 }  // namespace rig_calibrator

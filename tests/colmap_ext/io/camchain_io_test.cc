@@ -10,7 +10,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace camchain_io_test {
 
 colmap::Camera MakeCamera(const std::string& model,
                           const std::vector<double>& params, int width = 640,
@@ -273,5 +273,5 @@ TEST(CamchainIo, RefusesWhatItCannotRepresent) {
   EXPECT_FALSE(ColmapToKalibrCamera(no_size, &kalibr, &error));
 }
 
-}  // namespace
+}  // namespace camchain_io_test
 }  // namespace rig_calibrator

@@ -9,7 +9,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace correspondence_io_test {
 
 void WriteText(const std::string& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary);
@@ -181,5 +181,5 @@ TEST(CorrespondenceIo, DatasetCorrespondencesTakeTheCameraSize) {
   EXPECT_EQ(images[0].correspondences.size(), 3u);
 }
 
-}  // namespace
+}  // namespace correspondence_io_test
 }  // namespace rig_calibrator

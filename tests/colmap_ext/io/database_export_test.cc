@@ -19,7 +19,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace database_export_test {
 
 using testing::MakeScene;
 using testing::ReadBytes;
@@ -227,5 +227,5 @@ TEST(DatabaseExportTest, Colmap38PointTriangulatorTriangulatesFromRigMatches) {
   EXPECT_LT(triangulated.ComputeMeanReprojectionError(), 1e-3);
 }
 
-}  // namespace
+}  // namespace database_export_test
 }  // namespace rig_calibrator

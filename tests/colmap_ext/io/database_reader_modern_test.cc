@@ -10,7 +10,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace database_reader_modern_test {
 
 namespace fs = std::filesystem;
 using testing::ColmapSchema;
@@ -279,5 +279,5 @@ TEST(Colmap411DatabaseTest, ReadsTheRealFileWithoutTouchingIt) {
   EXPECT_EQ(testing::ListFolder(folder), files_before);
 }
 
-}  // namespace
+}  // namespace database_reader_modern_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace database_reader_test {
 
 namespace fs = std::filesystem;
 
@@ -281,5 +281,5 @@ TEST_F(DatabaseReaderTest, RejectsPartialRigTables) {
       << error;
 }
 
-}  // namespace
+}  // namespace database_reader_test
 }  // namespace rig_calibrator

@@ -25,7 +25,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace input_limits_test {
 
 void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -421,5 +421,5 @@ TEST(InputLimits, DatabaseKeypointsWithNegativeScaleOrNanAreRefused) {
   }
 }
 
-}  // namespace
+}  // namespace input_limits_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_consistency_test {
 
 constexpr int kNumPoints = 4;
 
@@ -241,5 +241,5 @@ TEST(MapConsistency, ImagesWithoutCameraOrPoseAreRefusedByName) {
             std::string::npos);
 }
 
-}  // namespace
+}  // namespace map_consistency_test
 }  // namespace rig_calibrator

@@ -13,7 +13,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_reader_test {
 
 namespace fs = std::filesystem;
 
@@ -156,5 +156,5 @@ TEST_F(MapCopyTest, RejectsRigsAndFramesThatDisagreeWithTheImages) {
   EXPECT_FALSE(info.has_rigs_frames);
 }
 
-}  // namespace
+}  // namespace map_reader_test
 }  // namespace rig_calibrator

@@ -18,7 +18,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace model_writer_output_test {
 
 namespace fs = std::filesystem;
 
@@ -223,5 +223,5 @@ TEST_P(ModelWriterOutput, WritesEverythingAndReadsBack) {
 INSTANTIATE_TEST_SUITE_P(BinAndTxt, ModelWriterOutput,
                          ::testing::Values("BIN", "TXT"));
 
-}  // namespace
+}  // namespace model_writer_output_test
 }  // namespace rig_calibrator

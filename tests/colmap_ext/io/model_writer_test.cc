@@ -20,7 +20,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace model_writer_test {
 
 namespace fs = std::filesystem;
 
@@ -241,5 +241,5 @@ TEST(ModelWriter, MovesRefinedMapPoints) {
   EXPECT_EQ(rig_model.model.NumPoints3D(), 0u);
 }
 
-}  // namespace
+}  // namespace model_writer_test
 }  // namespace rig_calibrator

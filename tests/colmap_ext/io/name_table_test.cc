@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 namespace rig_calibrator {
-namespace {
+namespace name_table_test {
 
 enum class Color { kRed, kGreen, kBlue };
 
@@ -28,5 +28,5 @@ TEST(NameTable, UnknownNamesAndValues) {
   EXPECT_EQ(NameOfValue(kColors, Color::kBlue, "unknown"), "unknown");
 }
 
-}  // namespace
+}  // namespace name_table_test
 }  // namespace rig_calibrator

@@ -5,7 +5,7 @@
 #include <limits>
 
 namespace rig_calibrator {
-namespace {
+namespace number_text_test {
 
 TEST(NumberText, DoublesRoundTripBitForBit) {
   for (const double value : {312.41, 1e-5, -0.5, 0.1 + 0.2, 6.02214076e23,
@@ -62,5 +62,5 @@ TEST(NumberText, ParseInt64IsStrict) {
   }
 }
 
-}  // namespace
+}  // namespace number_text_test
 }  // namespace rig_calibrator

@@ -11,7 +11,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace rig_config_io_test {
 
 colmap::Camera MakeCamera(const std::string& model,
                           const std::vector<double>& params,
@@ -233,5 +233,5 @@ TEST(RigConfigIo, PredictsColmap38SnapshotGrouping) {
       << grouping.problems[0];
 }
 
-}  // namespace
+}  // namespace rig_config_io_test
 }  // namespace rig_calibrator

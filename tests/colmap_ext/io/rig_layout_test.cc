@@ -6,7 +6,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace rig_layout_test {
 
 // The camera and frameset names of image i.
 std::pair<std::string, std::string> Where(const RigLayout& layout, int i) {
@@ -311,5 +311,5 @@ TEST(RigLayout, NaturalOrder) {
   EXPECT_FALSE(NaturalLess("x", "x"));
 }
 
-}  // namespace
+}  // namespace rig_layout_test
 }  // namespace rig_calibrator

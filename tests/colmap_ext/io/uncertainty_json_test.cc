@@ -11,7 +11,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace uncertainty_json_test {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -147,5 +147,5 @@ TEST(UncertaintyJson, TerminalLinesNameEveryComputedCamera) {
   EXPECT_NE(lines[2].find("undetermined"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace uncertainty_json_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace benchmark_command_test {
 
 using testing::RunCommand;
 
@@ -53,5 +53,5 @@ TEST(Benchmark, MethodsOptionSelectsTheMethods) {
             std::string::npos);
 }
 
-}  // namespace
+}  // namespace benchmark_command_test
 }  // namespace rig_calibrator

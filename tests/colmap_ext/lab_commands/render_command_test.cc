@@ -14,7 +14,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace render_command_test {
 
 namespace fs = boost::filesystem;
 
@@ -216,5 +216,5 @@ TEST(RenderCommand, CommandLineErrorsFailCleanly) {
   EXPECT_FALSE(fs::exists(out));
 }
 
-}  // namespace
+}  // namespace render_command_test
 }  // namespace rig_calibrator

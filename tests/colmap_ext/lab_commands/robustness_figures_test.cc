@@ -7,7 +7,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace robustness_figures_test {
 
 // A cell of two methods, the second with fallbacks, as the experiment
 // records it: per camera errors, infinity where a camera failed.
@@ -61,5 +61,5 @@ TEST(RobustnessFigures, GoodCalibrationsHasOneGroupPerCell) {
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace robustness_figures_test
 }  // namespace rig_calibrator

@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace descriptor_kd_forest_test {
 
 colmap::FeatureDescriptors RandomDescriptors(const int rows,
                                              const unsigned int seed) {
@@ -81,5 +81,5 @@ TEST(DescriptorKdForestTest, SameNeighboursOnEveryThread) {
   for (const auto& result : results) EXPECT_EQ(result, expected);
 }
 
-}  // namespace
+}  // namespace descriptor_kd_forest_test
 }  // namespace rig_calibrator

@@ -15,7 +15,7 @@
 #include "tests/colmap_ext/localization/localization_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace localization_determinism_test {
 
 colmap::FeatureDescriptors RandomDescriptors(const int num_rows,
                                              const unsigned int seed) {
@@ -149,5 +149,5 @@ TEST_F(LocalizationDeterminismTest, RetrievalByDirectVotesOnOneAndTwoThreads) {
   ExpectSameOnOneAndTwoThreads(options);
 }
 
-}  // namespace
+}  // namespace localization_determinism_test
 }  // namespace rig_calibrator

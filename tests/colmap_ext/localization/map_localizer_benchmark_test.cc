@@ -11,7 +11,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_localizer_benchmark_test {
 
 using testing::MakeScene;
 using testing::SceneConfig;
@@ -106,5 +106,5 @@ TEST(MapLocalizerBenchmark, DISABLED_Throughput) {
   }
 }
 
-}  // namespace
+}  // namespace map_localizer_benchmark_test
 }  // namespace rig_calibrator

@@ -18,7 +18,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_localizer_guidance_test {
 
 struct Counts {
   long correct = 0;
@@ -185,5 +185,5 @@ TEST(RadialLineIndexTest, MatchesPointsNearTheRadialLineOnItsSide) {
   EXPECT_EQ(matches[0].point3D_id, 4u);
 }
 
-}  // namespace
+}  // namespace map_localizer_guidance_test
 }  // namespace rig_calibrator

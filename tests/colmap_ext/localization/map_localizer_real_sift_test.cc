@@ -13,7 +13,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_localizer_real_sift_test {
 
 // A grey texture on the world plane z = 0 (x, y in [-1.5, 1.5]): random
 // Gaussian blobs of several sizes, which SIFT detects at several scales.
@@ -197,5 +197,5 @@ TEST(MapLocalizerRealSiftTest, LocalizesARenderedViewOfATexturedPlane) {
   }
 }
 
-}  // namespace
+}  // namespace map_localizer_real_sift_test
 }  // namespace rig_calibrator

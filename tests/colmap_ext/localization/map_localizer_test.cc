@@ -18,7 +18,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace map_localizer_test {
 
 namespace fs = std::filesystem;
 
@@ -287,5 +287,5 @@ TEST(SelectOneToOneCorrespondencesTest, KeepsTheBestSupportedPairs) {
   EXPECT_EQ(selected[2].point3D_id, 13u);
 }
 
-}  // namespace
+}  // namespace map_localizer_test
 }  // namespace rig_calibrator

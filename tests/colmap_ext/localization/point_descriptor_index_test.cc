@@ -9,7 +9,7 @@
 #include "tests/colmap_ext/colmap_testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace point_descriptor_index_test {
 
 TEST(SiftDescriptorAngleTest, FollowsColmapsNormalization) {
   colmap::FeatureDescriptor a = colmap::FeatureDescriptor::Zero(1, 128);
@@ -174,5 +174,5 @@ TEST(PointDescriptorIndexTest, EmptyIndexMatchesNothing) {
   EXPECT_TRUE(matches.empty());
 }
 
-}  // namespace
+}  // namespace point_descriptor_index_test
 }  // namespace rig_calibrator

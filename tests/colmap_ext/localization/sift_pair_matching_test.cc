@@ -12,7 +12,7 @@
 #include "tests/colmap_ext/colmap_testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace sift_pair_matching_test {
 
 // Image 1: 300 features; image 2: observations of 200 of them (shuffled by
 // reversing) and 100 features of its own.
@@ -74,5 +74,5 @@ TEST(MatchSiftDescriptorsTest, EmptyImageMatchesNothing) {
   EXPECT_TRUE(matches.empty());
 }
 
-}  // namespace
+}  // namespace sift_pair_matching_test
 }  // namespace rig_calibrator

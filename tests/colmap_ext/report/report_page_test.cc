@@ -17,7 +17,7 @@
 #include "tests/colmap_ext/report/report_testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace report_page_test {
 
 using testing::MakeScene;
 using testing::ReadBytes;
@@ -365,5 +365,5 @@ TEST(ReportPage, SizeForTenCamerasAndFiveHundredFramesets) {
   EXPECT_LT(size, 1500000u);
 }
 
-}  // namespace
+}  // namespace report_page_test
 }  // namespace rig_calibrator

@@ -10,7 +10,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace svg_plot_test {
 
 // Checks that the document is one well-nested tree of elements (a small
 // well-formedness check: tags open and close in order, attribute quotes are
@@ -163,5 +163,5 @@ TEST(SvgPlot, BarChartHasOneBarPerValue) {
   EXPECT_NE(svg.find(">ring5 hard<"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace svg_plot_test
 }  // namespace rig_calibrator

@@ -18,7 +18,7 @@
 #include "tests/src/calibration/final_ba_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace bundle_adjustment_determinism_test {
 
 using namespace final_ba_testing;  // NOLINT: the shared test fixture
 
@@ -64,7 +64,7 @@ void ExpectIdentical(const RigCalibration& a, const RigCalibration& b) {
 
 // Noisy data from a perturbed start: many iterations, so that any change of
 // the summation order shows in the last digits.
-SyntheticRig NoisyScene(const bool shared_points) {
+SyntheticBaScene NoisyScene(const bool shared_points) {
   SceneOptions options;
   options.shared_points = shared_points;
   options.noise_px = 0.5;
@@ -72,7 +72,7 @@ SyntheticRig NoisyScene(const bool shared_points) {
   return MakeSyntheticRig(options);
 }
 
-RigCalibration Adjust(const SyntheticRig& rig, const bool refine_points) {
+RigCalibration Adjust(const SyntheticBaScene& rig, const bool refine_points) {
   FinalBundleAdjustmentOptions options;
   options.refine_points = refine_points;
   options.num_threads = 1;
@@ -83,7 +83,7 @@ RigCalibration Adjust(const SyntheticRig& rig, const bool refine_points) {
 }
 
 TEST(BundleAdjustmentDeterminism, FinalWithRefinedPoints) {
-  const SyntheticRig rig = NoisyScene(/*shared_points=*/true);
+  const SyntheticBaScene rig = NoisyScene(/*shared_points=*/true);
   const RigCalibration first = Adjust(rig, true);
   ASSERT_FALSE(first.refined_points3D.empty());
   const RearrangedHeap heap;
@@ -91,11 +91,11 @@ TEST(BundleAdjustmentDeterminism, FinalWithRefinedPoints) {
 }
 
 TEST(BundleAdjustmentDeterminism, FinalWithFixedPoints) {
-  const SyntheticRig rig = NoisyScene(/*shared_points=*/false);
+  const SyntheticBaScene rig = NoisyScene(/*shared_points=*/false);
   const RigCalibration first = Adjust(rig, false);
   const RearrangedHeap heap;
   ExpectIdentical(first, Adjust(rig, false));
 }
 
-}  // namespace
+}  // namespace bundle_adjustment_determinism_test
 }  // namespace rig_calibrator

@@ -44,7 +44,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace bundle_solver_backends_test {
 
 // The bounds of the assertions, a few times above the worst measured
 // over repeated runs (docs/solver_comparison.md; Ceres' rounding varies
@@ -534,5 +534,5 @@ TEST(BundleSolverBackendsTest, UnconvergedSolveIsDetected) {
   EXPECT_GT(Compare(own.calibration, stopped).value, kMaxParameterDifference);
 }
 
-}  // namespace
+}  // namespace bundle_solver_backends_test
 }  // namespace rig_calibrator

@@ -16,7 +16,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace calibration_uncertainty_test {
 
 // A small synthetic rig: `num_framesets` framesets, exact map points unless
 // asked, 0.5 px noise, 20 % wrong matches.
@@ -557,5 +557,5 @@ TEST(CalibrationUncertainty, PipelineReportsIt) {
       [](const StageTiming& timing) { return timing.stage == "Uncertainty"; }));
 }
 
-}  // namespace
+}  // namespace calibration_uncertainty_test
 }  // namespace rig_calibrator

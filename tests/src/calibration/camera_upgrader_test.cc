@@ -16,7 +16,7 @@
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
-namespace {
+namespace camera_upgrader_test {
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -665,5 +665,5 @@ TEST(CameraUpgrader, RejectsUnsupportedModelAndBadInput) {
                              scene.points_cam, nullptr, &result));
 }
 
-}  // namespace
+}  // namespace camera_upgrader_test
 }  // namespace rig_calibrator

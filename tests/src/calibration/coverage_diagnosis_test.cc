@@ -12,7 +12,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace coverage_diagnosis_test {
 
 SyntheticRig Ring5() {
   SyntheticRigOptions options;
@@ -78,5 +78,5 @@ TEST(CoverageDiagnosis, CentralObservationsArePoorCoverage) {
   EXPECT_LT(report.coverage[2]->radius_ratio, 0.5);
 }
 
-}  // namespace
+}  // namespace coverage_diagnosis_test
 }  // namespace rig_calibrator

@@ -17,7 +17,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace degenerate_rig_test {
 
 // The pipeline tests' hard scenario: 0.5 px noise, 30% wrong matches, 10% of
 // the images missing.
@@ -230,5 +230,5 @@ TEST(DegenerateRig, MapUnitsChangeOnlyTheScale) {
   }
 }
 
-}  // namespace
+}  // namespace degenerate_rig_test
 }  // namespace rig_calibrator

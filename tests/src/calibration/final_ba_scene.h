@@ -34,7 +34,7 @@ struct SceneOptions {
 // A synthetic rig looking around (camera i turned by i * 360 / num_cameras
 // degrees about the rig's y axis), walked through a scene with points 2-10 m
 // away; some images are missing.
-struct SyntheticRig {
+struct SyntheticBaScene {
   RigDataset dataset;
   RigCalibration truth;
   // Per image, per correspondence: replaced by a random pixel.
@@ -76,7 +76,7 @@ inline bool InImage(const colmap::Camera& camera, const Eigen::Vector2d& x) {
          x.y() <= camera.Height();
 }
 
-inline SyntheticRig MakeSyntheticRig(const SceneOptions& options) {
+inline SyntheticBaScene MakeSyntheticRig(const SceneOptions& options) {
   std::mt19937 rng(options.seed);
   std::uniform_real_distribution<double> uniform(0, 1);
   std::normal_distribution<double> gaussian(0, 1);
@@ -85,7 +85,7 @@ inline SyntheticRig MakeSyntheticRig(const SceneOptions& options) {
         .normalized();
   };
 
-  SyntheticRig rig;
+  SyntheticBaScene rig;
   RigDataset& dataset = rig.dataset;
   RigCalibration& truth = rig.truth;
   for (int i = 0; i < options.num_cameras; ++i) {
@@ -213,7 +213,7 @@ inline Rigid3d Perturb(const Rigid3d& pose, double angle_deg, double distance,
 
 // The start of the adjustment: rotations off by 1 deg, translations by 2 cm,
 // focal lengths by 2 %, principal points by 10 px, k1 by 0.02.
-inline RigCalibration PerturbedStart(const SyntheticRig& rig, unsigned seed) {
+inline RigCalibration PerturbedStart(const SyntheticBaScene& rig, unsigned seed) {
   std::mt19937 rng(seed);
   RigCalibration start = rig.truth;
   for (size_t i = 0; i < start.cameras.size(); ++i) {
@@ -284,7 +284,7 @@ inline void PrintErrors(const char* label, const CalibrationErrors& e,
 
 // Exact data from a perturbed start: the truth to rounding, no residual,
 // nothing pruned.
-inline void ExpectExactSolution(const SyntheticRig& rig, const char* label,
+inline void ExpectExactSolution(const SyntheticBaScene& rig, const char* label,
                                 const RigCalibration& calibration,
                                 const FinalBundleAdjustmentSummary& summary) {
   const CalibrationErrors errors = Compare(calibration, rig.truth);

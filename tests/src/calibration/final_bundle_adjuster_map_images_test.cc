@@ -16,7 +16,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace final_bundle_adjuster_map_images_test {
 
 // A ring5 dataset with map images whose map points are `map_point_noise`
 // off; with `only_map_observed`, the rig keeps only correspondences of points
@@ -303,5 +303,5 @@ TEST(FinalBundleAdjusterMapImagesTest, RefineMapNeedsMapImages) {
   EXPECT_FALSE(AdjustRig(ba_options, rig.dataset, &calibration, nullptr));
 }
 
-}  // namespace
+}  // namespace final_bundle_adjuster_map_images_test
 }  // namespace rig_calibrator

@@ -15,7 +15,7 @@
 #include "tests/src/calibration/final_ba_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace final_bundle_adjuster_map_points_test {
 
 using namespace final_ba_testing;  // NOLINT: the shared test fixture
 
@@ -25,7 +25,7 @@ using namespace final_ba_testing;  // NOLINT: the shared test fixture
 // true position); points with an id that are seen once are dropped, so that
 // every point with an id is refined.
 struct MapPointScene {
-  SyntheticRig rig;
+  SyntheticBaScene rig;
   RigDataset dataset;
   RigCalibration start;
   std::unordered_map<int64_t, Eigen::Vector3d> truth_points;
@@ -243,5 +243,5 @@ TEST(FinalBundleAdjusterTest, PointsLeftWithOneObservationAreHeldFixed) {
   EXPECT_LT(errors.center, 1e-7);
 }
 
-}  // namespace
+}  // namespace final_bundle_adjuster_map_points_test
 }  // namespace rig_calibrator

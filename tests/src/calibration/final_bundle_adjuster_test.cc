@@ -10,12 +10,12 @@
 #include "tests/src/calibration/final_ba_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace final_bundle_adjuster_test {
 
 using namespace final_ba_testing;  // NOLINT: the shared test fixture
 
 TEST(FinalBundleAdjusterTest, RecoversExactRigFromPerturbedStart) {
-  const SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  const SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigCalibration calibration = PerturbedStart(rig, 2);
   const CalibrationErrors start = Compare(calibration, rig.truth);
   ASSERT_GT(start.rotation_deg, 0.5);
@@ -51,7 +51,7 @@ TEST(FinalBundleAdjusterTest, NoisyDataWithOutliersIsAccurateAndPrunesThem) {
   scene.num_points_per_image = 300;
   scene.noise_px = 0.5;
   scene.outlier_ratio = 0.1;
-  const SyntheticRig rig = MakeSyntheticRig(scene);
+  const SyntheticBaScene rig = MakeSyntheticRig(scene);
   RigCalibration calibration = PerturbedStart(rig, 3);
 
   FinalBundleAdjustmentSummary summary;
@@ -92,7 +92,7 @@ TEST(FinalBundleAdjusterTest, NoisyDataWithOutliersIsAccurateAndPrunesThem) {
 }
 
 TEST(FinalBundleAdjusterTest, FixedFocalLengthStaysUnchanged) {
-  const SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  const SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   const RigCalibration start = PerturbedStart(rig, 4);
   RigCalibration calibration = start;
   FinalBundleAdjustmentOptions options;
@@ -109,7 +109,7 @@ TEST(FinalBundleAdjusterTest, FixedFocalLengthStaysUnchanged) {
 }
 
 TEST(FinalBundleAdjusterTest, KnownIntrinsicsStayUnchangedAndPosesConverge) {
-  const SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  const SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigCalibration calibration = PerturbedStart(rig, 5);
   calibration.cameras = rig.truth.cameras;
   FinalBundleAdjustmentOptions options;
@@ -130,7 +130,7 @@ TEST(FinalBundleAdjusterTest, KnownIntrinsicsStayUnchangedAndPosesConverge) {
 TEST(FinalBundleAdjusterTest, NothingToRefineStillPrunesOutliers) {
   SceneOptions scene;
   scene.outlier_ratio = 0.1;
-  const SyntheticRig rig = MakeSyntheticRig(scene);
+  const SyntheticBaScene rig = MakeSyntheticRig(scene);
   RigCalibration calibration = rig.truth;
   FinalBundleAdjustmentOptions options;
   options.refine_focal_length = false;
@@ -158,7 +158,7 @@ TEST(FinalBundleAdjusterTest, NothingToRefineStillPrunesOutliers) {
 TEST(FinalBundleAdjusterTest, FisheyeRigConverges) {
   SceneOptions scene;
   scene.model_id = colmap::OpenCVFisheyeCameraModel::kModelId;
-  const SyntheticRig rig = MakeSyntheticRig(scene);
+  const SyntheticBaScene rig = MakeSyntheticRig(scene);
   RigCalibration calibration = PerturbedStart(rig, 7);
   FinalBundleAdjustmentSummary summary;
   ASSERT_TRUE(AdjustRig(FinalBundleAdjustmentOptions(), rig.dataset,
@@ -167,7 +167,7 @@ TEST(FinalBundleAdjusterTest, FisheyeRigConverges) {
 }
 
 TEST(FinalBundleAdjusterTest, RejectsPointsBehindAndFarFromTheCamera) {
-  SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigImage& image = rig.dataset.images[0];
   const Rigid3d world_from_cam =
       rig.truth.CamFromWorld(image.camera_index, image.frameset_index)
@@ -192,7 +192,7 @@ TEST(FinalBundleAdjusterTest, RejectsPointsBehindAndFarFromTheCamera) {
 }
 
 TEST(FinalBundleAdjusterTest, UsesOnlyInliersOfPosedFramesetsAndCameras) {
-  SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigCalibration calibration = PerturbedStart(rig, 9);
   calibration.rig_from_world[1].reset();
   calibration.camera_calibrated[2] = false;
@@ -219,7 +219,7 @@ TEST(FinalBundleAdjusterTest, UsesOnlyInliersOfPosedFramesetsAndCameras) {
 }
 
 TEST(FinalBundleAdjusterTest, RejectsInconsistentInput) {
-  const SyntheticRig rig = MakeSyntheticRig(SceneOptions());
+  const SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigCalibration calibration = PerturbedStart(rig, 10);
   RigCalibration bad = calibration;
   bad.rig_from_world.pop_back();
@@ -260,7 +260,7 @@ TEST(FinalBundleAdjusterTest, DISABLED_LargeInstanceTiming) {
   scene.noise_px = 0.5;
   scene.outlier_ratio = 0.05;
   const auto start = std::chrono::steady_clock::now();
-  const SyntheticRig rig = MakeSyntheticRig(scene);
+  const SyntheticBaScene rig = MakeSyntheticRig(scene);
   RigCalibration calibration = PerturbedStart(rig, 11);
   std::printf(
       "scene made in %.2f s\n",
@@ -273,5 +273,5 @@ TEST(FinalBundleAdjusterTest, DISABLED_LargeInstanceTiming) {
   std::printf("%s\n", summary.solver_report.c_str());
 }
 
-}  // namespace
+}  // namespace final_bundle_adjuster_test
 }  // namespace rig_calibrator

@@ -17,7 +17,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace front_back_rig_test {
 
 // ring5's layout with two cameras: yaw 0 and 180 degrees on the 0.15 m ring,
 // pitched by 2 and -3 degrees (axes 179 degrees apart). The pipeline tests'
@@ -115,5 +115,5 @@ TEST(FrontBackRig, WithoutFallbackFailsWithTheReason) {
   EXPECT_NE(report.error.find("rd_ra"), std::string::npos) << report.error;
 }
 
-}  // namespace
+}  // namespace front_back_rig_test
 }  // namespace rig_calibrator

@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace rig_calibrator {
-namespace {
+namespace image_coverage_test {
 
 colmap::Camera Camera(int width, int height) {
   colmap::Camera camera;
@@ -81,5 +81,5 @@ TEST(ImageCoverage, PoorCoverageIsDetectedWithItsNumbers) {
   EXPECT_NE(why.find("10x8 image cells"), std::string::npos) << why;
 }
 
-}  // namespace
+}  // namespace image_coverage_test
 }  // namespace rig_calibrator

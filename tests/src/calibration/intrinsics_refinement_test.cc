@@ -14,7 +14,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace intrinsics_refinement_test {
 
 SyntheticRigOptions ShortSequence(int num_framesets, unsigned int seed) {
   SyntheticRigOptions options;
@@ -203,5 +203,5 @@ TEST(IntrinsicsRefinement, HeldTruePrincipalPointIsAtLeastAsAccurate) {
   EXPECT_LE(held_projection, free_projection);
 }
 
-}  // namespace
+}  // namespace intrinsics_refinement_test
 }  // namespace rig_calibrator

@@ -6,7 +6,7 @@
 #include <cmath>
 
 namespace rig_calibrator {
-namespace {
+namespace map_anchoring_test {
 
 // A free-gauge solution: the map's points, two rig poses and a cam_from_rig,
 // all moved by the similarity X_solution = s R X_map + t, so that every
@@ -104,5 +104,5 @@ TEST(AnchorRefinedPointsToMap, RefusesPointsItCannotPlace) {
   EXPECT_EQ(few.solution.refined_points3D, few_before.refined_points3D);
 }
 
-}  // namespace
+}  // namespace map_anchoring_test
 }  // namespace rig_calibrator

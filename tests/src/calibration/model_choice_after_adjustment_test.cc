@@ -18,7 +18,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace model_choice_after_adjustment_test {
 
 using testing::MakeCamera;
 
@@ -257,5 +257,5 @@ TEST(ModelChoiceAfterAdjustment, ChoiceRuleClustersTheStandardError) {
   EXPECT_EQ(by_framesets.chosen, "RADIAL");
 }
 
-}  // namespace
+}  // namespace model_choice_after_adjustment_test
 }  // namespace rig_calibrator

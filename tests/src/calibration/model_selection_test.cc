@@ -18,7 +18,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace model_selection_test {
 
 using testing::MakeCamera;
 
@@ -368,5 +368,5 @@ TEST(ModelSelection, CandidatesWorseOnTrainingErrorAloneAreNotHeldOut) {
   EXPECT_FALSE(full.candidates[1].as_good_as_best);
 }
 
-}  // namespace
+}  // namespace model_selection_test
 }  // namespace rig_calibrator

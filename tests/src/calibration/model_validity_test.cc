@@ -16,7 +16,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace model_validity_test {
 
 using testing::MakeCamera;
 
@@ -228,5 +228,5 @@ TEST(ModelValidity, FoldStaysTheReasonWhenTheModelAlsoMisfits) {
   EXPECT_EQ(validity.suggested_model, "OPENCV_FISHEYE");
 }
 
-}  // namespace
+}  // namespace model_validity_test
 }  // namespace rig_calibrator

@@ -9,7 +9,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace pipeline_test {
 
 PipelineOptions QuietOptions(CalibrationMethod method) {
   PipelineOptions options;
@@ -334,5 +334,5 @@ TEST(Pipeline, InvalidDatasetIsRejected) {
   EXPECT_NE(report.error.find("at least two cameras"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace pipeline_test
 }  // namespace rig_calibrator

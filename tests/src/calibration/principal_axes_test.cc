@@ -11,7 +11,7 @@
 
 namespace rig_calibrator {
 namespace testing {
-namespace {
+namespace principal_axes_test {
 
 // The principal axis of a camera turned by yaw_deg about y from looking
 // along +z.
@@ -191,6 +191,6 @@ TEST(NormalizeRadialRigOrigin, KeepsRadialProjectionsAndIsIdempotent) {
   }
 }
 
-}  // namespace
+}  // namespace principal_axes_test
 }  // namespace testing
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 
 namespace rig_calibrator {
 namespace testing {
-namespace {
+namespace radial_bundle_adjuster_test {
 
 // The truth's rig with rotations turned by about `angle_deg` and translations
 // moved by about `shift` (tx, ty of the cameras; all of the rig poses): the
@@ -267,6 +267,6 @@ TEST(AdjustRadialRig, InconsistentInputFails) {
             calibration.cameras[1].PrincipalPointX());
 }
 
-}  // namespace
+}  // namespace radial_bundle_adjuster_test
 }  // namespace testing
 }  // namespace rig_calibrator

@@ -15,7 +15,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace radial_residual_profile_test {
 
 const Eigen::Vector2d kPrincipalPoint(322.5, 241.0);
 
@@ -319,5 +319,5 @@ TEST(RadialResidualProfile, TooFewOrUnusablePointsAreNotEvaluated) {
   EXPECT_TRUE(profile.systematic);
 }
 
-}  // namespace
+}  // namespace radial_residual_profile_test
 }  // namespace rig_calibrator

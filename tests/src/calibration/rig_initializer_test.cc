@@ -10,7 +10,7 @@
 
 namespace rig_calibrator {
 namespace testing {
-namespace {
+namespace rig_initializer_test {
 
 // InitializeRig on a copy of the scene's input; fails with its message.
 ::testing::AssertionResult Initialize(const RadialRigScene& scene,
@@ -367,6 +367,6 @@ TEST(InitializeRig, InconsistentInputFails) {
   EXPECT_NE(summary.message.find("non-finite"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace rig_initializer_test
 }  // namespace testing
 }  // namespace rig_calibrator

@@ -11,7 +11,7 @@
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_intrinsics_estimator_test {
 
 using testing::MakeRadialIntrinsics;
 using testing::MakeRadialIntrinsicsScene;
@@ -197,5 +197,5 @@ TEST(RadialIntrinsicsEstimator, KnownFocalEstimatesWithTheGivenFocal) {
   }
 }
 
-}  // namespace
+}  // namespace radial_intrinsics_estimator_test
 }  // namespace rig_calibrator

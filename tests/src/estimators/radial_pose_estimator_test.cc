@@ -19,7 +19,7 @@
 #include "tests/src/solvers/radial_pose_test_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_pose_estimator_test {
 
 constexpr double kFocalPx = 500;
 
@@ -589,5 +589,5 @@ TEST(EstimateRadialPose, Timing) {
   }
 }
 
-}  // namespace
+}  // namespace radial_pose_estimator_test
 }  // namespace rig_calibrator

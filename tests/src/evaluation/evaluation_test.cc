@@ -10,7 +10,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace evaluation_test {
 
 // cam_from_rig of a camera turned by `rotation` (applied in the camera
 // frame) and moved by `center_offset` (in the rig frame).
@@ -377,5 +377,5 @@ TEST(Evaluation, TableAndJsonReportEveryCamera) {
   EXPECT_EQ(json["scale"].get<double>(), 1.0);
 }
 
-}  // namespace
+}  // namespace evaluation_test
 }  // namespace rig_calibrator

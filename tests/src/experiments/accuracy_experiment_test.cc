@@ -11,7 +11,7 @@
 #include "src/experiments/robustness_experiment.h"
 
 namespace rig_calibrator {
-namespace {
+namespace accuracy_experiment_test {
 
 std::vector<std::string> Split(const std::string& line, char separator) {
   std::vector<std::string> fields;
@@ -227,5 +227,5 @@ TEST(RobustnessExperiment, OneCellRecordsInitialAndFinalErrors) {
   }
 }
 
-}  // namespace
+}  // namespace accuracy_experiment_test
 }  // namespace rig_calibrator

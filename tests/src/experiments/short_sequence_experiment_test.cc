@@ -6,7 +6,7 @@
 #include <limits>
 
 namespace rig_calibrator {
-namespace {
+namespace short_sequence_experiment_test {
 
 // A smaller version of the README's 100-sequence experiment (run with
 // `rig_calibrator_lab benchmark`): 1dr must calibrate almost every short
@@ -77,5 +77,5 @@ TEST(ShortSequenceExperiment, MedianWithFailuresRanksFailuresLast) {
   EXPECT_TRUE(std::isnan(MedianWithFailures({})));
 }
 
-}  // namespace
+}  // namespace short_sequence_experiment_test
 }  // namespace rig_calibrator

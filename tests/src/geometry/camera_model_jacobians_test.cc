@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace camera_model_jacobians_test {
 
 // Normalized points from the centre (where the fisheye switches branch) to
 // the edge of a wide field of view, and random ones.
@@ -145,5 +145,5 @@ TEST(CameraModelJacobians, OtherModelsUseJets) {
   EXPECT_DOUBLE_EQ(d_params[5 + 3], 1);  // dy/dcy
 }
 
-}  // namespace
+}  // namespace camera_model_jacobians_test
 }  // namespace rig_calibrator

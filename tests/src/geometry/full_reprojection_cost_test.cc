@@ -8,7 +8,7 @@
 #include <memory>
 
 namespace rig_calibrator {
-namespace {
+namespace full_reprojection_cost_test {
 
 // The residual with Ceres' automatic differentiation: the reference.
 template <typename CameraModel>
@@ -83,5 +83,5 @@ TEST(FullReprojectionCost, JacobiansMatchAutoDiff) {
   ExpectMatchesAutoDiff<colmap::ThinPrismFisheyeCameraModel>();
 }
 
-}  // namespace
+}  // namespace full_reprojection_cost_test
 }  // namespace rig_calibrator

@@ -10,7 +10,7 @@
 #include "src/geometry/radial_residual.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_error_test {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -180,5 +180,5 @@ TEST(RadialResidual, NormIsTheDistanceToTheHalfLine) {
   }
 }
 
-}  // namespace
+}  // namespace radial_error_test
 }  // namespace rig_calibrator

@@ -9,7 +9,7 @@
 #include "src/geometry/radial_error.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_reprojection_cost_test {
 
 // Residual of the cost function at a pose, with its Jacobians.
 struct Evaluation {
@@ -88,5 +88,5 @@ TEST(RadialReprojectionCost, OnTheOpticalAxisIsX) {
   }
 }
 
-}  // namespace
+}  // namespace radial_reprojection_cost_test
 }  // namespace rig_calibrator

@@ -11,7 +11,7 @@
 #include "src/geometry/radial_residual.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_rig_cost_function_test {
 
 // The same residual by automatic differentiation: the reference for the
 // analytic Jacobians.
@@ -220,5 +220,5 @@ TEST(RadialRigCostFunction, MatchesAutomaticDifferentiation) {
   EXPECT_NEAR(residual[1], -10, 1e-12);
 }
 
-}  // namespace
+}  // namespace radial_rig_cost_function_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "src/geometry/rigid3d.h"
 
 namespace rig_calibrator {
-namespace {
+namespace rig_reprojection_cost_test {
 
 Eigen::Quaterniond RotationAboutAxis(double angle_rad,
                                      const Eigen::Vector3d& axis) {
@@ -202,5 +202,5 @@ TEST(RigReprojectionCost, JacobiansMatchAutoDiffForEveryModel) {
             nullptr);
 }
 
-}  // namespace
+}  // namespace rig_reprojection_cost_test
 }  // namespace rig_calibrator

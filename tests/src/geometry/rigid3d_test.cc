@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 namespace rig_calibrator {
-namespace {
+namespace rigid3d_test {
 
 Rigid3d RandomTransform(int seed) {
   std::srand(seed);
@@ -82,5 +82,5 @@ TEST(Rigid3d, AngleAxisTranslationRoundTrip) {
   EXPECT_LT((back.translation - pose.translation).norm(), 1e-15);
 }
 
-}  // namespace
+}  // namespace rigid3d_test
 }  // namespace rig_calibrator

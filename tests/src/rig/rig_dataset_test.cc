@@ -12,7 +12,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace rig_dataset_test {
 
 // Two cameras, two framesets, three images (frameset "f1" misses cam1), and
 // the calibration that matches it.
@@ -113,5 +113,5 @@ TEST_F(ValidateCalibrationTest, RejectsInlierMasksOfTheWrongLength) {
               "the image cam0/f1.png has 1 inlier flags for 3");
 }
 
-}  // namespace
+}  // namespace rig_dataset_test
 }  // namespace rig_calibrator

@@ -13,7 +13,7 @@
 #include "src/geometry/rig_reprojection_cost.h"
 
 namespace rig_calibrator {
-namespace {
+namespace bundle_levenberg_marquardt_test {
 
 using Pose = std::array<double, 7>;  // [qw, qx, qy, qz, tx, ty, tz]
 
@@ -740,5 +740,5 @@ TEST(BundleLevenbergMarquardtTest, GaussNewtonSystemIsTheSchurComplement) {
             Eigen::MatrixXd(solver.ReducedMatrix()));
 }
 
-}  // namespace
+}  // namespace bundle_levenberg_marquardt_test
 }  // namespace rig_calibrator

@@ -6,7 +6,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace division_intrinsics_solver_test {
 
 // Data from the division model itself: pick the distorted pixel, undistort
 // it, and place the 3D point on the undistorted ray at depth 2-10. Minimal
@@ -89,5 +89,5 @@ TEST(SolveDivisionIntrinsics, RejectsBadInput) {
       std::vector<Eigen::Vector3d>(5, Eigen::Vector3d(0.1, 0, 5)), 3, &model));
 }
 
-}  // namespace
+}  // namespace division_intrinsics_solver_test
 }  // namespace rig_calibrator

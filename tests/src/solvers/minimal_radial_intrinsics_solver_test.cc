@@ -16,7 +16,7 @@
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace minimal_radial_intrinsics_solver_test {
 
 using testing::AddPoint;
 using testing::kPi;
@@ -393,5 +393,5 @@ TEST(SolveMinimalRadialIntrinsics, KnownFocalRejectsDegenerateSamples) {
   }
 }
 
-}  // namespace
+}  // namespace minimal_radial_intrinsics_solver_test
 }  // namespace rig_calibrator

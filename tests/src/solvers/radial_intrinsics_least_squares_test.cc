@@ -10,7 +10,7 @@
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_intrinsics_least_squares_test {
 
 using testing::MakeRadialIntrinsics;
 using testing::MakeRadialIntrinsicsScene;
@@ -113,5 +113,5 @@ TEST(SolveRadialIntrinsicsLeastSquares, RejectsMirroringProfiles) {
                   .empty());
 }
 
-}  // namespace
+}  // namespace radial_intrinsics_least_squares_test
 }  // namespace rig_calibrator

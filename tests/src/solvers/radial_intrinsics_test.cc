@@ -8,7 +8,7 @@
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_intrinsics_test {
 
 using testing::MakeRadialIntrinsics;
 
@@ -83,5 +83,5 @@ TEST(RadialIntrinsics, RadiusGrowsOverPoints) {
   EXPECT_FALSE(RadiusGrowsOverPoints(x, {Eigen::Vector3d(0.1, 0, 1)}, model));
 }
 
-}  // namespace
+}  // namespace radial_intrinsics_test
 }  // namespace rig_calibrator

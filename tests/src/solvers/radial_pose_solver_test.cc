@@ -15,7 +15,7 @@
 #include "tests/src/solvers/radial_pose_test_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_pose_solver_test {
 
 enum class SceneKind { kGeneral, kNearPlanar, kPlanar };
 
@@ -273,5 +273,5 @@ TEST(RadialPoseSolver, AppendsToExistingSolutions) {
   EXPECT_EQ(solutions[0].translation, Eigen::Vector3d::Zero());
 }
 
-}  // namespace
+}  // namespace radial_pose_solver_test
 }  // namespace rig_calibrator

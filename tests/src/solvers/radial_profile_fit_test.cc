@@ -9,7 +9,7 @@
 #include "tests/src/solvers/radial_intrinsics_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace radial_profile_fit_test {
 
 using testing::MakeRadialIntrinsics;
 using testing::MakeRadialIntrinsicsScene;
@@ -177,5 +177,5 @@ TEST(RefineRadialProfileAndTz, KnownFocalConvergesFromAWrongTz) {
   }
 }
 
-}  // namespace
+}  // namespace radial_profile_fit_test
 }  // namespace rig_calibrator

@@ -21,7 +21,7 @@
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
-namespace {
+namespace dataset_fingerprint_test {
 
 class Fingerprint {
  public:
@@ -158,5 +158,5 @@ TEST(DatasetFingerprint, SameSeedGivesTheRecordedDatasets) {
 #endif
 }
 
-}  // namespace
+}  // namespace dataset_fingerprint_test
 }  // namespace rig_calibrator

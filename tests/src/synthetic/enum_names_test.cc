@@ -10,7 +10,7 @@
 #include "src/synthetic/textured_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace enum_names_test {
 
 enum class Color { kRed, kGreen, kBlue };
 constexpr EnumNameTable<Color, 2> kColorNames = {
@@ -60,5 +60,5 @@ TEST(EnumNames, RigPresetsAndSceneTypes) {
                        {"room", "courtyard", "street"});
 }
 
-}  // namespace
+}  // namespace enum_names_test
 }  // namespace rig_calibrator

@@ -6,7 +6,7 @@
 #include <set>
 
 namespace rig_calibrator {
-namespace {
+namespace rendered_dataset_test {
 
 RenderedDatasetOptions Options(RigPreset preset, SceneType scene) {
   RenderedDatasetOptions options;
@@ -133,5 +133,5 @@ TEST(RenderedDataset, RejectsInvalidOptions) {
   EXPECT_NE(error.find("would stand in a wall"), std::string::npos) << error;
 }
 
-}  // namespace
+}  // namespace rendered_dataset_test
 }  // namespace rig_calibrator

@@ -12,7 +12,7 @@
 #include "tests/testing.h"
 
 namespace rig_calibrator {
-namespace {
+namespace scene_renderer_test {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
@@ -320,5 +320,5 @@ TEST(SceneRenderer, SiftFindsThousandsOfFeatures) {
   }
 }
 
-}  // namespace
+}  // namespace scene_renderer_test
 }  // namespace rig_calibrator

@@ -8,7 +8,7 @@
 #include <set>
 
 namespace rig_calibrator {
-namespace {
+namespace synthetic_rig_test {
 
 // Pixel error of a correspondence under the true calibration; infinity when
 // the 3D point is behind the camera.
@@ -574,11 +574,11 @@ TEST(SyntheticRig, RingWithNCameras) {
   EXPECT_FALSE(options.Check(&error));
 }
 
-}  // namespace
+}  // namespace synthetic_rig_test
 }  // namespace rig_calibrator
 
 namespace rig_calibrator {
-namespace {
+namespace synthetic_rig_test {
 
 // Degenerate rigs (issue 15): several stereo pairs, facing one way or
 // alternately forward and backward.
@@ -703,5 +703,5 @@ TEST(SyntheticRig, MapObservationsPerImageCapsEachMapImage) {
   EXPECT_NE(error.find("map_observations_per_image"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace synthetic_rig_test
 }  // namespace rig_calibrator
