@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <random>
@@ -224,14 +225,39 @@ RefinedParams RefinedParamsOfModel(const CameraUpgradeOptions& options) {
   return refined;
 }
 
+// The rows the LM of a round runs on: of its n inliers in index order, the
+// floor(j n / m)-th for j = 0..m-1, m = min(n, max_num_refinement_points):
+// spread evenly over the input (a camera's rows come frame after frame) and
+// the same for the same input.
+std::vector<int> RefinementRows(const CameraUpgradeOptions& options,
+                                const std::vector<char>& inlier_mask,
+                                const int num_inliers) {
+  const int64_t num_rows =
+      std::min(num_inliers, options.max_num_refinement_points);
+  std::vector<int> rows;
+  rows.reserve(num_rows);
+  int64_t inlier_idx = 0;
+  for (size_t i = 0;
+       i < inlier_mask.size() && static_cast<int64_t>(rows.size()) < num_rows;
+       ++i) {
+    if (!inlier_mask[i]) continue;
+    // The next row to take is the floor(j n / m)-th inlier, j = rows.size().
+    if (inlier_idx ==
+        static_cast<int64_t>(rows.size()) * num_inliers / num_rows) {
+      rows.push_back(static_cast<int>(i));
+    }
+    ++inlier_idx;
+  }
+  return rows;
+}
+
 // The LM problem of one refinement round: tz and the model's parameters (the
-// held ones fixed), a Cauchy-robustified full
-// reprojection residual per inlier.
+// held ones fixed), a Cauchy-robustified full reprojection residual per row.
 template <typename CameraModel>
 void BuildRefinementProblem(const CameraUpgradeOptions& options,
                             const std::vector<Eigen::Vector2d>& points2D,
                             const std::vector<Eigen::Vector3d>& points_cam,
-                            const std::vector<char>& inlier_mask, double* tz,
+                            const std::vector<int>& rows, double* tz,
                             std::vector<double>* params,
                             ceres::Problem* problem,
                             std::vector<ceres::ResidualBlockId>* blocks) {
@@ -246,25 +272,32 @@ void BuildRefinementProblem(const CameraUpgradeOptions& options,
   }
   ceres::LossFunction* loss = new ceres::CauchyLoss(options.loss_scale_px);
   blocks->clear();
-  for (size_t i = 0; i < points2D.size(); ++i) {
-    if (inlier_mask[i]) {
-      blocks->push_back(problem->AddResidualBlock(
-          new FullReprojectionCost<CameraModel>(points2D[i], points_cam[i]),
-          loss, tz, params->data()));
-    }
+  for (const int row : rows) {
+    blocks->push_back(problem->AddResidualBlock(
+        new FullReprojectionCost<CameraModel>(points2D[row], points_cam[row]),
+        loss, tz, params->data()));
   }
 }
 
-// The conditioning fields of `result` from the final round's problem.
+// The conditioning fields of `result` from the final round's problem, whose
+// `blocks` are an even subsample of that round's `num_inliers` inliers.
 template <typename CameraModel>
 void SetConditioning(const ceres::Problem& problem,
                      const std::vector<ceres::ResidualBlockId>& blocks,
-                     const RefinedParams& refined,
+                     const int num_inliers, const RefinedParams& refined,
                      const std::vector<Eigen::Vector3d>& points_cam,
                      const double tz, const std::vector<double>& params,
                      CameraUpgradeResult* result) {
-  const Conditioning conditioning = ComputeConditioning(
+  Conditioning conditioning = ComputeConditioning(
       problem, blocks, refined.focal_tangent_idxs, refined.num_tangent_params);
+  // J^T J is a sum over rows, so that of all n inliers is about n / m times
+  // that of an even subsample of m of them, and C = (J^T J)^-1 about m / n
+  // times: var_n = (m / n) var_m, stddev_n = sqrt(m / n) stddev_m. The
+  // correlation, a ratio of entries of C, does not change.
+  const double subsample_fraction =
+      static_cast<double>(blocks.size()) / num_inliers;
+  conditioning.tz_variance *= subsample_fraction;
+  conditioning.focal_variance *= subsample_fraction;
   double mean_focal = 0;
   for (const size_t i : CameraModel::focal_length_idxs) {
     mean_focal += params[i] / CameraModel::focal_length_idxs.size();
@@ -283,8 +316,9 @@ void SetConditioning(const ceres::Problem& problem,
       result->tz_stddev_at_1px <= kMaxRelativeStddevAt1px * median_depth;
 }
 
-// Step 3: LM over tz and the model's parameters on the inliers, inliers
-// re-evaluated on all points, repeated while they change.
+// Step 3: LM over tz and the model's parameters on the inliers (at most
+// max_num_refinement_points of them), inliers re-evaluated on all points,
+// repeated while they change.
 template <typename CameraModel>
 bool RefineUpgrade(const CameraUpgradeOptions& options,
                    const std::vector<Eigen::Vector2d>& points2D,
@@ -293,6 +327,13 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
                    std::vector<double>* params, CameraUpgradeResult* result) {
   const RefinedParams refined = RefinedParamsOfModel<CameraModel>(options);
   const int num_unknowns = 1 + refined.num_tangent_params;
+  if (options.max_num_refinement_points < num_unknowns) {
+    result->error_message = "max_num_refinement_points " +
+                            std::to_string(options.max_num_refinement_points) +
+                            " is below the " + std::to_string(num_unknowns) +
+                            " unknowns of the refinement";
+    return false;
+  }
 
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -319,7 +360,8 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
     ceres::Problem problem;
     std::vector<ceres::ResidualBlockId> residual_blocks;
     BuildRefinementProblem<CameraModel>(
-        options, points2D, points_cam, inlier_mask, &refined_tz,
+        options, points2D, points_cam,
+        RefinementRows(options, inlier_mask, num_inliers), &refined_tz,
         &refined_params, &problem, &residual_blocks);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
@@ -335,9 +377,9 @@ bool RefineUpgrade(const CameraUpgradeOptions& options,
         points2D, points_cam, valid, refined_tz, refined_params,
         options.max_error_px, &inlier_mask, &result->rms_px);
     if (inlier_mask == previous_mask || round + 1 == kMaxNumRefinementRounds) {
-      SetConditioning<CameraModel>(problem, residual_blocks, refined,
-                                   points_cam, refined_tz, refined_params,
-                                   result);
+      SetConditioning<CameraModel>(problem, residual_blocks, num_inliers,
+                                   refined, points_cam, refined_tz,
+                                   refined_params, result);
       break;
     }
   }
@@ -398,6 +440,9 @@ std::string CheckOptions(const CameraUpgradeOptions& options) {
   }
   if (options.max_num_ransac_points < 1) {
     return "max_num_ransac_points must be >= 1";
+  }
+  if (options.max_num_refinement_points < 1) {
+    return "max_num_refinement_points must be >= 1";
   }
   if (!(options.loss_scale_px > 0)) return "loss_scale_px must be > 0";
   if (options.max_num_iterations < 1) return "max_num_iterations must be >= 1";

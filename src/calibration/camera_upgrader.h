@@ -16,9 +16,10 @@
 //     model has them, every other distortion term 0.
 //  3. Levenberg-Marquardt (Ceres, Cauchy loss) over tz and all parameters of
 //     the model (the principal point too unless told otherwise) on the full
-//     reprojection error through COLMAP's templated WorldToImage, then the
-//     inliers are re-evaluated on all points; repeated while they change
-//     (at most 3 times).
+//     reprojection error through COLMAP's templated WorldToImage, on the
+//     inliers or an even subsample of at most max_num_refinement_points of
+//     them, then the inliers are re-evaluated on all points; repeated while
+//     they change (at most 3 times).
 //
 // Used for each rig camera with its frames pooled and, for the `rd`
 // baseline, for single images.
@@ -42,6 +43,17 @@ struct CameraUpgradeOptions {
   // camera pooled over hundreds of frames has 1e5 of them); the inliers are
   // then evaluated on all of them.
   int max_num_ransac_points = 10000;
+  // Each round of the final LM runs on at most this many of the inliers,
+  // evenly spaced in index order (of n, the floor(j n / m)-th for j < m =
+  // min(n, max)): a camera pooled over hundreds of frames has 1e5 of them,
+  // the LM's cost grows with their number, and a dozen parameters gain little
+  // from more. The inliers are then re-evaluated on all correspondences, and
+  // the conditioning below is that of all the inliers. Must be at least the
+  // number of unknowns (tz and the refined parameters). At 10000, the model
+  // choice's candidates, fitted on at most as many rows
+  // (ModelSelectionOptions::max_num_fit_rows), use all their inliers: only
+  // the chosen model's fit to every row is subsampled.
+  int max_num_refinement_points = 10000;
   double loss_scale_px = 1.0;  // Cauchy scale in the final LM
   int max_num_iterations = 100;
   // COLMAP's refine_* switches (intrinsics_refinement.h): a parameter not
@@ -65,8 +77,9 @@ struct CameraUpgradeResult {
 
   // Conditioning of the tz/focal trade-off. With
   // C = (J^T J)^-1, J the (Cauchy-weighted) Jacobian of the final LM's
-  // residuals in pixels over tz and every refined parameter, and f the mean
-  // of the model's focal lengths:
+  // residuals in pixels over tz and every refined parameter (of all that
+  // round's inliers: from its subsample of m of the n, C is scaled by m / n),
+  // and f the mean of the model's focal lengths:
   //   tz_focal_correlation = C(tz, f) / sqrt(C(tz, tz) C(f, f)).
   // It tends to 1 when the depths of the points vary little relative to
   // their distance, since then only f / (c + tz) is observed; 1 when J^T J is

@@ -379,6 +379,126 @@ TEST(CameraUpgrader, RansacOnSubsetOfManyPoints) {
   ExpectFocalAndPrincipalPointNear(upgrade.camera, upgrade.truth, 0.0005, 0.1);
 }
 
+// The final LM on 200 of 2000 exact correspondences: the truth as from all.
+TEST(CameraUpgrader, SubsampledRefinementExactData) {
+  CameraUpgradeOptions options;
+  options.max_num_refinement_points = 200;
+  for (const std::string model_name : {"OPENCV", "OPENCV_FISHEYE"}) {
+    SCOPED_TRACE(model_name);
+    const ModelCase& model_case = FindModelCase(model_name);
+    SceneOptions scene_options = SceneOptionsFor(model_case);
+    scene_options.num_points = 2000;
+    const Upgrade upgrade =
+        RunUpgrade(model_case, scene_options, Eigen::Vector2d(4, -3), options);
+    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+    EXPECT_EQ(upgrade.result.num_inliers, scene_options.num_points);
+    EXPECT_LT(upgrade.result.rms_px, 1e-8);
+    EXPECT_TRUE(upgrade.result.well_conditioned);
+    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
+    ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
+                     kPrincipalPointTolerancePx, kDistortionTolerance);
+  }
+}
+
+// 0.5 px noise, 30 % wrong matches, 4000 correspondences (~2800 inliers):
+// the final LM on 1000 of the inliers against all of them. Both estimate the
+// same parameters from nested data, the full one efficiently, so their
+// difference has variance var_sub - var_full = var_full (n / m - 1); tz and f
+// must agree within 4 of its sigmas, sigma_full = 0.5 px * stddev_at_1px.
+// The subsample's conditioning, scaled by m / n, must be that of all the
+// inliers within 10 %. Measured: tz and f <= 1.4 sigmas apart, stddevs
+// <= 5 % apart, correlations <= 0.015 apart.
+TEST(CameraUpgrader, SubsampledRefinementNoisyDataMatchesAll) {
+  constexpr double kNoisePx = 0.5;
+  for (const std::string model_name : {"OPENCV", "OPENCV_FISHEYE"}) {
+    SCOPED_TRACE(model_name);
+    const ModelCase& model_case = FindModelCase(model_name);
+    const SceneOptions scene_options =
+        NoisySceneOptionsFor(model_case, 4000, 0.3);
+    CameraUpgradeOptions all_options;
+    all_options.max_num_refinement_points = scene_options.num_points;
+    CameraUpgradeOptions subsample_options;
+    subsample_options.max_num_refinement_points = 1000;
+    const Upgrade all = RunUpgrade(model_case, scene_options,
+                                   Eigen::Vector2d(4, -3), all_options);
+    const Upgrade subsample = RunUpgrade(
+        model_case, scene_options, Eigen::Vector2d(4, -3), subsample_options);
+    ASSERT_TRUE(all.success) << all.result.error_message;
+    ASSERT_TRUE(subsample.success) << subsample.result.error_message;
+    ExpectInliersRecovered(subsample.scene, subsample.result, 0.99, 0.005);
+
+    const double sqrt_ratio_minus_1 =
+        std::sqrt(static_cast<double>(all.result.num_inliers) /
+                      subsample_options.max_num_refinement_points -
+                  1);
+    const double tz_sigma =
+        kNoisePx * all.result.tz_stddev_at_1px * sqrt_ratio_minus_1;
+    const double focal_sigma =
+        kNoisePx * all.result.focal_stddev_at_1px * sqrt_ratio_minus_1;
+    EXPECT_NEAR(subsample.result.tz, all.result.tz, 4 * tz_sigma);
+    EXPECT_NEAR(subsample.camera.MeanFocalLength(),
+                all.camera.MeanFocalLength(), 4 * focal_sigma);
+    std::cout << model_name << ": tz "
+              << std::abs(subsample.result.tz - all.result.tz) / tz_sigma
+              << " sigmas, f "
+              << std::abs(subsample.camera.MeanFocalLength() -
+                          all.camera.MeanFocalLength()) /
+                     focal_sigma
+              << " sigmas apart; stddev ratios tz "
+              << subsample.result.tz_stddev_at_1px / all.result.tz_stddev_at_1px
+              << ", f "
+              << subsample.result.focal_stddev_at_1px /
+                     all.result.focal_stddev_at_1px
+              << ", correlations " << subsample.result.tz_focal_correlation
+              << " / " << all.result.tz_focal_correlation << "\n";
+
+    EXPECT_NEAR(subsample.result.tz_stddev_at_1px, all.result.tz_stddev_at_1px,
+                0.1 * all.result.tz_stddev_at_1px);
+    EXPECT_NEAR(subsample.result.focal_stddev_at_1px,
+                all.result.focal_stddev_at_1px,
+                0.1 * all.result.focal_stddev_at_1px);
+    EXPECT_NEAR(subsample.result.tz_focal_correlation,
+                all.result.tz_focal_correlation, 0.05);
+    EXPECT_EQ(subsample.result.well_conditioned, all.result.well_conditioned);
+  }
+}
+
+// Which rows the final LM uses: of 2000 inliers with 200 to keep, every 10th
+// (rows 0, 10, 20, ...). Those are exact; every other row is off by 1 px,
+// well within the inlier threshold. From the exact rows alone the truth is
+// recovered; all rows (the option at 2000) pull the principal point by
+// 0.95 px (measured).
+TEST(CameraUpgrader, SubsampledRefinementUsesEvenlySpacedInliers) {
+  const ModelCase& model_case = FindModelCase("OPENCV");
+  const colmap::Camera truth =
+      MakeCamera(model_case.model_name, 640, 480, model_case.params);
+  SceneOptions scene_options = SceneOptionsFor(model_case);
+  scene_options.num_points = 2000;
+  Scene scene = MakeScene(truth, scene_options);
+  for (size_t i = 0; i < scene.points2D.size(); ++i) {
+    if (i % 10 != 0) scene.points2D[i].x() += 1;
+  }
+  for (const int max_num_refinement_points : {200, 2000}) {
+    SCOPED_TRACE(max_num_refinement_points);
+    CameraUpgradeOptions options;
+    options.max_num_refinement_points = max_num_refinement_points;
+    colmap::Camera camera = MakeInputCamera(truth, Eigen::Vector2d(4, -3));
+    CameraUpgradeResult result;
+    ASSERT_TRUE(UpgradeCamera(options, scene.points2D, scene.points_cam,
+                              &camera, &result))
+        << result.error_message;
+    EXPECT_EQ(result.num_inliers, scene_options.num_points);
+    if (max_num_refinement_points == 200) {
+      EXPECT_NEAR(result.tz, scene.tz, 1e-8);
+      ExpectParamsNear(camera, truth, kFocalRelativeTolerance,
+                       kPrincipalPointTolerancePx, kDistortionTolerance);
+    } else {
+      EXPECT_GT(std::abs(camera.PrincipalPointX() - truth.PrincipalPointX()),
+                0.5);
+    }
+  }
+}
+
 TEST(CameraUpgrader, FixedPrincipalPoint) {
   const ModelCase& model_case = FindModelCase("RADIAL");
   CameraUpgradeOptions options;
@@ -646,6 +766,18 @@ TEST(CameraUpgrader, RejectsUnsupportedModelAndBadInput) {
   options.max_error_px = 0;
   EXPECT_FALSE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
                              &result));
+  options = CameraUpgradeOptions();
+  options.max_num_refinement_points = 0;
+  EXPECT_FALSE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
+                             &result));
+  EXPECT_NE(result.error_message.find("max_num_refinement_points"),
+            std::string::npos);
+  // Fewer refinement points than RADIAL's 6 unknowns (tz, f, c, k1, k2).
+  options.max_num_refinement_points = 5;
+  EXPECT_FALSE(UpgradeCamera(options, scene.points2D, scene.points_cam, &camera,
+                             &result));
+  EXPECT_NE(result.error_message.find("max_num_refinement_points"),
+            std::string::npos);
   // Parameters that do not match the model.
   colmap::Camera wrong_params = camera;
   wrong_params.Params().pop_back();
