@@ -266,6 +266,19 @@ Upgrade RunUpgrade(
   return upgrade;
 }
 
+// An upgrade on exact data: every point an inlier, no residual, tz and the
+// parameters at the truth.
+void ExpectExactRecovery(const Upgrade& upgrade, int num_points,
+                         double distortion_tolerance) {
+  ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
+  EXPECT_EQ(upgrade.result.num_inliers, num_points);
+  EXPECT_LT(upgrade.result.rms_px, 1e-8);
+  EXPECT_TRUE(upgrade.result.well_conditioned);
+  EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
+  ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
+                   kPrincipalPointTolerancePx, distortion_tolerance);
+}
+
 // Exact data: tz and every parameter of every supported model.
 TEST(CameraUpgrader, ExactDataRecoversEveryModel) {
   for (const ModelCase& model_case : AllModelCases()) {
@@ -273,16 +286,10 @@ TEST(CameraUpgrader, ExactDataRecoversEveryModel) {
     const SceneOptions scene_options = SceneOptionsFor(model_case);
     const Upgrade upgrade =
         RunUpgrade(model_case, scene_options, Eigen::Vector2d(4, -3));
-    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
-    EXPECT_EQ(upgrade.result.num_inliers, scene_options.num_points);
-    EXPECT_LT(upgrade.result.rms_px, 1e-8);
-    EXPECT_TRUE(upgrade.result.well_conditioned);
-    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
-    ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
-                     kPrincipalPointTolerancePx,
-                     model_case.model_name == "FULL_OPENCV"
-                         ? kRationalDistortionTolerance
-                         : kDistortionTolerance);
+    ExpectExactRecovery(upgrade, scene_options.num_points,
+                        model_case.model_name == "FULL_OPENCV"
+                            ? kRationalDistortionTolerance
+                            : kDistortionTolerance);
   }
 }
 
@@ -390,13 +397,7 @@ TEST(CameraUpgrader, SubsampledRefinementExactData) {
     scene_options.num_points = 2000;
     const Upgrade upgrade =
         RunUpgrade(model_case, scene_options, Eigen::Vector2d(4, -3), options);
-    ASSERT_TRUE(upgrade.success) << upgrade.result.error_message;
-    EXPECT_EQ(upgrade.result.num_inliers, scene_options.num_points);
-    EXPECT_LT(upgrade.result.rms_px, 1e-8);
-    EXPECT_TRUE(upgrade.result.well_conditioned);
-    EXPECT_NEAR(upgrade.result.tz, upgrade.scene.tz, 1e-8);
-    ExpectParamsNear(upgrade.camera, upgrade.truth, kFocalRelativeTolerance,
-                     kPrincipalPointTolerancePx, kDistortionTolerance);
+    ExpectExactRecovery(upgrade, scene_options.num_points, kDistortionTolerance);
   }
 }
 
