@@ -11,12 +11,6 @@
 namespace rig_calibrator {
 namespace {
 
-// An observation (image id, point2D index) as one key.
-uint64_t ObservationKey(const colmap::image_t image_id,
-                        const colmap::point2D_t point2D_idx) {
-  return (static_cast<uint64_t>(image_id) << 32) | point2D_idx;
-}
-
 std::string Id(const uint64_t id) { return std::to_string(id); }
 
 // The point ids in increasing order, so that the repairs' examples are the
@@ -97,28 +91,35 @@ bool ConfirmsPoint(const colmap::Point2D& point2D,
          point2D.XY().allFinite();
 }
 
+// Per image, per point2D: whether a track lists it (RepairTracks). A
+// point2D names one point, and only that point's track can list it, so
+// these flags say what a map from (image, point2D) to the listing point
+// would (10^6 hashed entries for an output model, a third of reading it).
+using TrackedPoints2D = std::unordered_map<colmap::image_t, std::vector<char>>;
+
 // Drops the track elements that their image does not confirm (and repeated
-// ones); returns the observations that the remaining tracks hold, each with
-// its point.
-std::unordered_map<uint64_t, colmap::point3D_t> RepairTracks(
-    colmap::Reconstruction* map, MapRepairs* repairs) {
-  std::unordered_map<uint64_t, colmap::point3D_t> tracked;
+// ones); returns the observations that the remaining tracks hold.
+TrackedPoints2D RepairTracks(colmap::Reconstruction* map, MapRepairs* repairs) {
+  TrackedPoints2D tracked;
+  tracked.reserve(map->NumImages());
+  for (const auto& [image_id, image] : map->Images()) {
+    tracked[image_id].assign(image.NumPoints2D(), 0);
+  }
   for (const colmap::point3D_t point3D_id : SortedPointIds(*map)) {
     colmap::Track& track = map->Point3D(point3D_id).Track();
     std::vector<colmap::TrackElement> kept;
     kept.reserve(track.Length());
     for (const colmap::TrackElement& element : track.Elements()) {
+      const auto image = tracked.find(element.image_id);
       const bool confirmed =
-          map->ExistsImage(element.image_id) &&
-          element.point2D_idx < map->Image(element.image_id).NumPoints2D() &&
+          image != tracked.end() &&
+          element.point2D_idx < image->second.size() &&
           ConfirmsPoint(
               map->Image(element.image_id).Point2D(element.point2D_idx),
               point3D_id) &&
-          tracked
-              .emplace(ObservationKey(element.image_id, element.point2D_idx),
-                       point3D_id)
-              .second;
+          !image->second[element.point2D_idx];
       if (confirmed) {
+        image->second[element.point2D_idx] = 1;
         kept.push_back(element);
         continue;
       }
@@ -134,9 +135,8 @@ std::unordered_map<uint64_t, colmap::point3D_t> RepairTracks(
 }
 
 // Drops the observations that no track confirms.
-void RepairObservations(
-    const std::unordered_map<uint64_t, colmap::point3D_t>& tracked,
-    colmap::Reconstruction* map, MapRepairs* repairs) {
+void RepairObservations(const TrackedPoints2D& tracked,
+                        colmap::Reconstruction* map, MapRepairs* repairs) {
   std::vector<colmap::image_t> image_ids;
   for (const auto& [image_id, image] : map->Images()) {
     image_ids.push_back(image_id);
@@ -144,11 +144,10 @@ void RepairObservations(
   std::sort(image_ids.begin(), image_ids.end());
   for (const colmap::image_t image_id : image_ids) {
     colmap::Image& image = map->Image(image_id);
+    const std::vector<char>& listed = tracked.at(image_id);
     for (colmap::point2D_t idx = 0; idx < image.NumPoints2D(); ++idx) {
       const colmap::Point2D& point2D = image.Point2D(idx);
-      if (!point2D.HasPoint3D()) continue;
-      const auto it = tracked.find(ObservationKey(image_id, idx));
-      if (it != tracked.end() && it->second == point2D.Point3DId()) continue;
+      if (!point2D.HasPoint3D() || listed[idx]) continue;
       if (repairs->num_dropped_observations++ == 0) {
         repairs->dropped_observation_example =
             "image " + image.Name() + ", point2D " + Id(idx) + " -> point " +
@@ -210,8 +209,7 @@ bool CheckMapConsistency(const std::string& path, const bool binary,
   if (!CheckCamerasAndImages(path, binary ? ".bin" : ".txt", *map, error)) {
     return false;
   }
-  const std::unordered_map<uint64_t, colmap::point3D_t> tracked =
-      RepairTracks(map, repairs);
+  const TrackedPoints2D tracked = RepairTracks(map, repairs);
   RepairObservations(tracked, map, repairs);
   RepairPoints(map, repairs);
   return true;

@@ -27,6 +27,7 @@
 #include "src/geometry/tangent_jacobian_cost.h"
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_levenberg_marquardt.h"
+#include "src/solvers/huge_page_allocator.h"
 
 namespace rig_calibrator {
 namespace {
@@ -217,7 +218,7 @@ class UncertaintyProblem {
   // The intrinsics of the rig cameras and of the map cameras, copied: the
   // solver takes non-const values.
   std::vector<std::vector<double>> params_, map_params_;
-  std::vector<Observation> observations_;
+  LargeVector<Observation> observations_;  // 10^6: huge_page_allocator.h
   std::vector<int64_t> point_ids_;  // refined points in the problem
   std::unordered_map<int64_t, int> point_index_;
   std::vector<Eigen::Vector3d> points_;  // positions of the refined points
@@ -236,7 +237,7 @@ class UncertaintyProblem {
   // system (BuildReducedSystem): the points eliminated, S over O and C.
   RigPoseManifold pose_manifold_;
   std::vector<std::unique_ptr<ceres::SubsetManifold>> intrinsics_manifolds_;
-  std::vector<std::unique_ptr<ceres::CostFunction>> residual_costs_;
+  LargeVector<std::unique_ptr<ceres::CostFunction>> residual_costs_;
   std::unique_ptr<BundleLevenbergMarquardt> solver_;
   // S (both triangles), with the gauge priors once AddGaugePriors added
   // them.
@@ -295,8 +296,8 @@ void UncertaintyProblem::CollectObservations() {
     params_.push_back(calibration_.cameras[c].Params());
   }
   const auto point_index = [&](int64_t point3D_id) {
-    const auto [it, inserted] =
-        point_index_.emplace(point3D_id, static_cast<int>(point_ids_.size()));
+    const auto [it, inserted] = point_index_.try_emplace(
+        point3D_id, static_cast<int>(point_ids_.size()));
     if (inserted) point_ids_.push_back(point3D_id);
     return it->second;
   };
@@ -707,8 +708,16 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
       }
       return false;
     }
-    x_oc_ =
-        scale_o_.asDiagonal() * ldlt_o_.solve(scale_o_.asDiagonal() * r_oc_);
+    // x_oc = R_OO^-1 R_OC, its columns on all threads: Eigen's solve of
+    // several right-hand sides goes column by column, so each is computed
+    // as in one solve of all.
+    const Eigen::MatrixXd scaled_r_oc = scale_o_.asDiagonal() * r_oc_;
+    x_oc_.resize(num_o_, num_c_);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+    for (int c = 0; c < num_c_; ++c) {
+      x_oc_.col(c) = ldlt_o_.solve(scaled_r_oc.col(c));
+    }
+    x_oc_ = scale_o_.asDiagonal() * x_oc_;
     schur -= r_oc_.transpose() * x_oc_;
   }
   covariance_c_ = ScaledPseudoInverse(schur, &undetermined_c_);

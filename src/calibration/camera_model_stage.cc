@@ -329,22 +329,34 @@ void CheckCameraModels(const PipelineOptions& options,
       options.model_selection.validity.residual_profile;
   profile_options.systematic_floor_px =
       MapSystematicFloorPx(options, dataset, calibration);
-  for (size_t c = 0; c < dataset.cameras.size(); ++c) {
+  // The cameras' checks are independent: one thread each, reported in
+  // camera order below (the same whatever the thread count).
+  const int num_cameras = static_cast<int>(dataset.cameras.size());
+  std::vector<ModelValidity> validities(num_cameras);
+  std::vector<RadialResidualProfile> profiles(num_cameras);
+#pragma omp parallel for schedule(dynamic) num_threads( \
+    options.num_threads > 0 ? options.num_threads : omp_get_max_threads())
+  for (int c = 0; c < num_cameras; ++c) {
     if (!calibration.camera_calibrated[c]) continue;
     const colmap::Camera& camera = calibration.cameras[c];
-    ModelValidity validity =
+    validities[c] =
         CheckModelValidity(camera, options.model_selection.validity);
     std::vector<Eigen::Vector2d> observed, projected;
     std::vector<int> images;
-    FinalInlierPixels(dataset, calibration, static_cast<int>(c), &observed,
-                      &projected, &images);
+    FinalInlierPixels(dataset, calibration, c, &observed, &projected, &images);
+    profiles[c] = ComputeRadialResidualProfile(
+        Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
+        observed, projected, images, profile_options);
+  }
+  for (int c = 0; c < num_cameras; ++c) {
+    if (!calibration.camera_calibrated[c]) continue;
+    const colmap::Camera& camera = calibration.cameras[c];
+    ModelValidity& validity = validities[c];
+    const RadialResidualProfile& profile = profiles[c];
     const IntrinsicsRefinement& refinement = dataset.cameras[c].refinement;
     const bool parameters_held = !refinement.focal_length ||
                                  !refinement.principal_point ||
                                  !refinement.extra_params;
-    const RadialResidualProfile profile = ComputeRadialResidualProfile(
-        Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
-        observed, projected, images, profile_options);
     AddResidualProfileCheck(camera, profile, parameters_held, &validity);
     if (parameters_held && !validity.fits_data) {
       AddDiagnostic(
@@ -356,15 +368,13 @@ void CheckCameraModels(const PipelineOptions& options,
               ", where a model that fits leaves no such bias: the given "
               "values (or the model) do not fit the data. Check them, or "
               "let the calibration refine them.",
-          {static_cast<int>(c)});
+          {c});
     }
-    CameraModelReportOf(dataset, static_cast<int>(c), report).validity =
-        validity;
+    CameraModelReportOf(dataset, c, report).validity = validity;
     if (!validity.valid) {
       AddDiagnostic(
           report, Diagnostic::Level::kError, "invalid_camera_model",
-          "camera " + dataset.cameras[c].name + ": " + validity.message,
-          {static_cast<int>(c)});
+          "camera " + dataset.cameras[c].name + ": " + validity.message, {c});
     }
   }
 }

@@ -142,8 +142,9 @@ double RigAdjustment::MapRmsError() {
   }
   const std::vector<MapObservationRef> in_problem = MapObservationsInProblem();
   double sum = 0;
-  for (const MapObservationRef& observation : in_problem) {
-    sum += Evaluate(observation).residual.squaredNorm();
+  for (const auto& [slot, error] :
+       EvaluateWithSlots(/*with_rig_observations=*/false, in_problem)) {
+    sum += error.residual.squaredNorm();
   }
   return in_problem.empty() ? 0 : std::sqrt(sum / in_problem.size());
 }
@@ -153,9 +154,8 @@ int RigAdjustment::NumThreads() const {
                                   : omp_get_max_threads();
 }
 
-std::vector<RigAdjustment::ObservationError>
-RigAdjustment::EvaluateObservations() const {
-  std::vector<ObservationError> errors(observations_.size());
+RigAdjustment::ObservationErrors RigAdjustment::EvaluateObservations() const {
+  ObservationErrors errors(observations_.size());
   const int64_t num_observations = static_cast<int64_t>(observations_.size());
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int64_t k = 0; k < num_observations; ++k) {
@@ -164,15 +164,14 @@ RigAdjustment::EvaluateObservations() const {
   return errors;
 }
 
-std::vector<std::pair<int, RigAdjustment::ObservationError>>
-RigAdjustment::EvaluateWithSlots(
+RigAdjustment::SlotErrors RigAdjustment::EvaluateWithSlots(
     bool with_rig_observations,
     const std::vector<MapObservationRef>& map_observations) const {
   const int64_t num_rig =
       with_rig_observations ? static_cast<int64_t>(observations_.size()) : 0;
   const int64_t num_all =
       num_rig + static_cast<int64_t>(map_observations.size());
-  std::vector<std::pair<int, ObservationError>> errors(num_all);
+  SlotErrors errors(num_all);
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int64_t k = 0; k < num_all; ++k) {
     if (k < num_rig) {
@@ -246,7 +245,7 @@ void RigAdjustment::SelectRefinedPoints() {
   if (first_selection) {
     for (size_t k = 0; k < rig_ids.size(); ++k) {
       if (k == 0 || rig_ids[k].first != rig_ids[k - 1].first) {
-        map_points_.emplace(
+        map_points_.try_emplace(
             rig_ids[k].first,
             CorrespondenceOf(observations_[rig_ids[k].second]).point3D);
       }
@@ -354,13 +353,15 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
     result.num_inliers = 0;
     result.rms_px = 0;
   }
+  // The errors on all threads, summed per image in observation order.
+  const ObservationErrors errors = EvaluateObservations();
   std::vector<double> sum_squared_error(dataset_.images.size(), 0);
-  for (const Observation& observation : observations_) {
+  for (size_t k = 0; k < observations_.size(); ++k) {
+    const Observation& observation = observations_[k];
     ImageResult& result = calibration->images[observation.image];
     result.inlier_mask[observation.correspondence] = 1;
     ++result.num_inliers;
-    sum_squared_error[observation.image] +=
-        Evaluate(observation).residual.squaredNorm();
+    sum_squared_error[observation.image] += errors[k].residual.squaredNorm();
   }
   for (size_t i = 0; i < dataset_.images.size(); ++i) {
     ImageResult& result = calibration->images[i];

@@ -17,6 +17,7 @@
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_solver.h"
+#include "src/solvers/huge_page_allocator.h"
 
 namespace rig_calibrator {
 
@@ -88,16 +89,20 @@ class RigAdjustment {
     double depth = 0;  // z in the camera frame
     Eigen::Vector2d residual = Eigen::Vector2d::Zero();
   };
+  // Per observation (10^6), in huge pages (huge_page_allocator.h): the
+  // error, and with it its pruning slot.
+  using ObservationErrors = LargeVector<ObservationError>;
+  using SlotErrors = LargeVector<std::pair<int, ObservationError>>;
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
   ObservationError Evaluate(const Observation& observation) const;
   // Evaluate of every rig observation, in their order, on all threads.
-  std::vector<ObservationError> EvaluateObservations() const;
+  ObservationErrors EvaluateObservations() const;
   ObservationError Evaluate(const MapObservationRef& observation) const;
   // (slot, Evaluate) of every rig observation (`with_rig_observations`),
   // then of `map_observations`, in that order, on all threads.
-  std::vector<std::pair<int, ObservationError>> EvaluateWithSlots(
+  SlotErrors EvaluateWithSlots(
       bool with_rig_observations,
       const std::vector<MapObservationRef>& map_observations) const;
   int NumThreads() const;
@@ -129,8 +134,7 @@ class RigAdjustment {
   // Per slot (rig cameras, then map cameras), max(min_outlier_error_px,
   // outlier_sigma_factor * sigma), sigma the robust spread of the residual
   // components of the slot's observations in front of their camera.
-  std::vector<double> MaxErrorPerSlot(
-      const std::vector<std::pair<int, ObservationError>>& errors) const;
+  std::vector<double> MaxErrorPerSlot(const SlotErrors& errors) const;
 
   // The problem (solver_), at the first solve: its blocks and residuals over
   // the rig observations and `map_observations` (MapObservationsInProblem()).
@@ -149,7 +153,7 @@ class RigAdjustment {
   std::vector<PoseParams> cam_from_rig_;
   std::vector<PoseParams> rig_from_world_;
   std::vector<bool> has_rig_pose_;
-  std::vector<Observation> observations_;
+  LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;
   // The map images (empty unless refine_points and map images):
   // intrinsics, poses, per observation whether it was rejected.

@@ -1,7 +1,6 @@
 #include "src/solvers/bundle_levenberg_marquardt.h"
 
 #include <glog/logging.h>
-#include <sys/mman.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
@@ -14,10 +13,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <thread>
 #include <unordered_map>
+
+#include "src/solvers/huge_page_allocator.h"
 
 namespace rig_calibrator {
 namespace {
@@ -84,14 +84,13 @@ inline void AddAB(const double* a, const double* b, int m, int k, int n,
 // group indices (a few hundred to a few thousand), where std::sort's
 // n log n comparisons were a third of the structure's time (perf, 100
 // framesets x 10 cameras).
-template <typename T, typename Key>
-void CountingSort(int range, Key key, std::vector<T>* items,
-                  std::vector<T>* buffer) {
+template <typename Vector, typename Key>
+void CountingSort(int range, Key key, Vector* items, Vector* buffer) {
   std::vector<size_t> begin(static_cast<size_t>(range) + 1, 0);
-  for (const T& item : *items) ++begin[key(item) + 1];
+  for (const auto& item : *items) ++begin[key(item) + 1];
   for (int k = 0; k < range; ++k) begin[k + 1] += begin[k];
   buffer->resize(items->size());
-  for (const T& item : *items) (*buffer)[begin[key(item)]++] = item;
+  for (const auto& item : *items) (*buffer)[begin[key(item)]++] = item;
   items->swap(*buffer);
 }
 
@@ -99,30 +98,16 @@ void CountingSort(int range, Key key, std::vector<T>* items,
 // (hundreds of MB at 10^6 residuals) are written in full by the first
 // (parallel) evaluation of every solve, so zeroing them first would touch
 // every page once more, on one thread (500 framesets x 10 cameras: the
-// structure of the first solve 3.1 -> 1.2 s). From 8 MB on it asks for
-// 2 MB pages (transparent huge pages, which Linux gives on request by
-// default): the first touch of each 4 KB page is a page fault, and those
-// were most of a single linearization (LinearizeGaussNewton, 360 000
-// residuals: its evaluation 0.37 -> 0.15 s). Smaller arrays would waste
-// much of a 2 MB page.
+// structure of the first solve 3.1 -> 1.2 s). In huge pages
+// (huge_page_allocator.h): the first touch of each 4 KB page was most of a
+// single linearization (LinearizeGaussNewton, 360 000 residuals: its
+// evaluation 0.37 -> 0.15 s).
 class UninitializedArray {
  public:
   void Resize(size_t size) {
     if (size != size_ || values_ == nullptr) {
-      constexpr size_t kHugePage = size_t{2} << 20;
-      const size_t bytes = std::max<size_t>(1, size) * sizeof(double);
-      if (bytes < 4 * kHugePage) {
-        values_.reset(static_cast<double*>(std::malloc(bytes)));
-      } else {
-        const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-        values_.reset(
-            static_cast<double*>(std::aligned_alloc(kHugePage, rounded)));
-#ifdef MADV_HUGEPAGE
-        if (values_ != nullptr) {
-          madvise(values_.get(), rounded, MADV_HUGEPAGE);  // a hint
-        }
-#endif
-      }
+      values_.reset(static_cast<double*>(
+          AllocateLarge(std::max<size_t>(1, size) * sizeof(double))));
       CHECK(values_ != nullptr) << "out of memory";
       size_ = size;
     }
@@ -134,7 +119,7 @@ class UninitializedArray {
 
  private:
   struct Free {
-    void operator()(double* p) const { std::free(p); }
+    void operator()(double* p) const { FreeLarge(p); }
   };
   std::unique_ptr<double[], Free> values_;
   size_t size_ = 0;
@@ -256,17 +241,25 @@ struct BundleLevenbergMarquardt::Impl {
       last_block{};
   std::vector<double*> points;
   std::vector<char> point_held;  // SetPointHeld
+  // A point's index by its address: by arithmetic while every point lies 3
+  // doubles after the previous one (a std::vector<Eigen::Vector3d>'s
+  // layout; a hash look-up per residual otherwise, 10^6 at every
+  // registration), else by point_index.
+  bool points_contiguous = true;
   std::unordered_map<const double*, int> point_index;
-  std::vector<Residual> residuals;
+  int PointIndex(const double* values) const;  // -1: not a point
+  LargeVector<Residual> residuals;
 
   // Structure (Solve), built at the first Solve after a block, point or
   // residual was added.
   bool structure_valid = false;
-  std::vector<size_t> residual_order;  // by point, pointless ones last
+  // The arrays below that grow with the residuals or the points are
+  // LargeVectors (huge_page_allocator.h).
+  LargeVector<size_t> residual_order;  // by point, pointless ones last
   std::vector<size_t> point_residuals_begin;
   std::vector<size_t> point_groups_begin, point_pairs_begin;
-  std::vector<int> point_groups, point_pairs;
-  std::vector<size_t> point_w_offsets;
+  LargeVector<int> point_groups, point_pairs;
+  LargeVector<size_t> point_w_offsets;
   PointStructure StructureOf(int p) const {
     PointStructure structure;
     structure.groups = point_groups.data() + point_groups_begin[p];
@@ -278,7 +271,7 @@ struct BundleLevenbergMarquardt::Impl {
   }
   std::vector<Chunk> chunks;
   std::vector<Batch> batches;
-  std::vector<size_t> batch_residuals;
+  LargeVector<size_t> batch_residuals;
   // Consecutive batches of about equal residual counts (they share the
   // per-chunk copies with `chunks`).
   std::vector<std::pair<size_t, size_t>> batch_chunks;
@@ -289,7 +282,7 @@ struct BundleLevenbergMarquardt::Impl {
   size_t pair_values_size = 0;
   int reduced_size = 0;
   Eigen::SparseMatrix<double> reduced;
-  std::vector<size_t> reduced_value_source;  // CSC entry -> pair value
+  LargeVector<size_t> reduced_value_source;  // CSC entry -> pair value
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>
       cholesky;
   // Its symbolic factorization of `reduced`'s pattern is done (by Solve:
@@ -297,19 +290,19 @@ struct BundleLevenbergMarquardt::Impl {
   bool pattern_analyzed = false;
 
   // Linearization at the current estimate.
-  std::vector<double> residual_values;  // corrected, 2 per residual
+  LargeVector<double> residual_values;  // corrected, 2 per residual
   UninitializedArray jacobians;
   std::vector<double> plus_jacobians;  // per block, size x tangent
   std::vector<size_t> plus_jacobian_offset;
-  std::vector<double> u_raw;     // camera-side block of J^T J (pairs)
+  LargeVector<double> u_raw;     // camera-side block of J^T J (pairs)
   std::vector<double> b_camera;  // J^T r, camera side
   std::vector<double> d_camera;  // diag(J^T J), camera side
-  std::vector<double> point_v;   // 3 x 3 per point, J_p^T J_p
-  std::vector<double> point_b;   // 3 per point
+  LargeVector<double> point_v;   // 3 x 3 per point, J_p^T J_p
+  LargeVector<double> point_b;   // 3 per point
   UninitializedArray point_w;    // W_pg per point and group
   // Step at the current radius.
-  std::vector<double> point_v_inverse;  // (V_p + D_p / mu)^-1
-  std::vector<double> point_step;
+  LargeVector<double> point_v_inverse;  // (V_p + D_p / mu)^-1
+  LargeVector<double> point_step;
   Eigen::VectorXd camera_step;
   // Per chunk: its copy of the reduced system and right-hand side. A copy
   // is written, zeroed and summed only over the pair values its chunk's
@@ -330,7 +323,7 @@ struct BundleLevenbergMarquardt::Impl {
   void SumChunkCopies(const double* base,
                       const std::vector<Intervals>& intervals, int num_chunks,
                       double* out) const;
-  std::vector<double> reduced_values;  // S, pair values, at each step
+  LargeVector<double> reduced_values;  // S, pair values, at each step
   // False while LinearizeGaussNewton evaluates: rho(s) = s for every
   // residual.
   bool robust_loss = true;
@@ -381,6 +374,22 @@ struct BundleLevenbergMarquardt::Impl {
   void ApplyStep(std::vector<double>* saved);
   void Restore(const std::vector<double>& saved);
 };
+
+int BundleLevenbergMarquardt::Impl::PointIndex(const double* values) const {
+  if (!points_contiguous) {
+    const auto point = point_index.find(values);
+    return point != point_index.end() ? point->second : -1;
+  }
+  if (points.empty()) return -1;
+  // Addresses as integers: comparing pointers into different arrays is
+  // undefined.
+  const uintptr_t first = reinterpret_cast<uintptr_t>(points.front());
+  const uintptr_t address = reinterpret_cast<uintptr_t>(values);
+  constexpr uintptr_t kPointBytes = 3 * sizeof(double);
+  if (address < first || (address - first) % kPointBytes != 0) return -1;
+  const uintptr_t index = (address - first) / kPointBytes;
+  return index < points.size() ? static_cast<int>(index) : -1;
+}
 
 void BundleLevenbergMarquardt::Impl::Restore(const std::vector<double>& saved) {
   size_t k = 0;
@@ -466,7 +475,7 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   // Pair blocks of the reduced system: every pair of groups that a residual
   // or a point couples.
   // Keys g << 32 | h of (g, h), g <= h (the group lists are ascending).
-  std::vector<uint64_t> pair_keys;
+  LargeVector<uint64_t> pair_keys;
   const auto key_of = [](int g, int h) {
     return static_cast<uint64_t>(g) << 32 | static_cast<uint32_t>(h);
   };
@@ -499,7 +508,7 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   // Sorted by (groups, index): the unused group slots are -1.
   using BatchKey =
       std::pair<std::array<int, kMaxParametersPerResidual>, size_t>;
-  std::vector<BatchKey> batch_keys(residuals.size());
+  LargeVector<BatchKey> batch_keys(residuals.size());
   for (size_t r = 0; r < residuals.size(); ++r) {
     batch_keys[r].first.fill(-1);
     std::copy(residuals[r].groups.begin(),
@@ -510,15 +519,15 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   // Lexicographic by (groups, index): stable passes from the last group
   // slot to the first, starting in index order.
   const int num_groups = static_cast<int>(groups.size());
-  std::vector<BatchKey> sort_buffer;
+  LargeVector<BatchKey> sort_buffer;
   for (int slot = kMaxParametersPerResidual - 1; slot >= 0; --slot) {
     CountingSort(
         num_groups + 1,
         [slot](const BatchKey& key) { return key.first[slot] + 1; },
         &batch_keys, &sort_buffer);
   }
-  sort_buffer = std::vector<BatchKey>();
-  std::vector<size_t> by_groups(residuals.size());
+  sort_buffer = LargeVector<BatchKey>();
+  LargeVector<size_t> by_groups(residuals.size());
   for (size_t r = 0; r < residuals.size(); ++r) {
     by_groups[r] = batch_keys[r].second;
   }
@@ -581,7 +590,7 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
     pair_keys.push_back(key_of(g, g));  // the LM diagonal of every group
   }
-  std::vector<uint64_t> key_buffer;
+  LargeVector<uint64_t> key_buffer;
   CountingSort(
       num_groups,
       [](uint64_t key) { return static_cast<int>(key & 0xffffffffu); },
@@ -600,9 +609,20 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
     pair_values_size +=
         static_cast<size_t>(groups[row].size) * groups[col].size;
   }
+  // The pair block (g, h): searched among row g's, a few hundred of the
+  // 10^5 blocks.
+  std::vector<size_t> row_pairs_begin(num_groups + 1, 0);
+  for (const PairBlock& pair : pair_blocks) {
+    ++row_pairs_begin[pair.row_group + 1];
+  }
+  for (int g = 0; g < num_groups; ++g) {
+    row_pairs_begin[g + 1] += row_pairs_begin[g];
+  }
   const auto pair_of = [&](int g, int h) {
     return static_cast<int>(
-        std::lower_bound(pair_keys.begin(), pair_keys.end(), key_of(g, h)) -
+        std::lower_bound(pair_keys.begin() + row_pairs_begin[g],
+                         pair_keys.begin() + row_pairs_begin[g + 1],
+                         key_of(g, h)) -
         pair_keys.begin());
   };
   const auto list_pairs = [&](const int* group_list, int n,
@@ -621,42 +641,95 @@ bool BundleLevenbergMarquardt::Impl::BuildStructure(std::string* error) {
   for (Batch& batch : batches) {
     list_pairs(batch.groups.data(), batch.num_groups, &batch.pairs);
   }
-  point_pairs_begin.assign(1, 0);
-  point_pairs.clear();
-  std::vector<int> pairs;
+  // Per point, the pairs of its n groups: n (n + 1) / 2 of them, looked up
+  // on all threads.
+  point_pairs_begin.assign(num_points + 1, 0);
   for (int p = 0; p < num_points; ++p) {
-    list_pairs(
-        point_groups.data() + point_groups_begin[p],
-        static_cast<int>(point_groups_begin[p + 1] - point_groups_begin[p]),
-        &pairs);
-    point_pairs.insert(point_pairs.end(), pairs.begin(), pairs.end());
-    point_pairs_begin.push_back(point_pairs.size());
+    const size_t n = point_groups_begin[p + 1] - point_groups_begin[p];
+    point_pairs_begin[p + 1] = point_pairs_begin[p] + n * (n + 1) / 2;
   }
-
-  // The upper triangle of the reduced system in CSC form, with the pair
-  // value behind each entry: the pattern is built once by Eigen from
-  // triplets whose values are the (exactly representable) source indices.
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(pair_values_size);
-  for (const PairBlock& pair : pair_blocks) {
-    const Group& row = groups[pair.row_group];
-    const Group& col = groups[pair.col_group];
-    for (int i = 0; i < row.size; ++i) {
-      for (int j = 0; j < col.size; ++j) {
-        if (pair.row_group == pair.col_group && j < i) continue;
-        triplets.emplace_back(
-            row.offset + i, col.offset + j,
-            static_cast<double>(pair.offset + i * col.size + j));
+  point_pairs.resize(point_pairs_begin[num_points]);
+#pragma omp parallel for schedule(static) num_threads(NumThreads())
+  for (int p = 0; p < num_points; ++p) {
+    const int* group_list = point_groups.data() + point_groups_begin[p];
+    const int n =
+        static_cast<int>(point_groups_begin[p + 1] - point_groups_begin[p]);
+    int* pairs = point_pairs.data() + point_pairs_begin[p];
+    for (int i = 0; i < n; ++i) {
+      for (int j = i; j < n; ++j) {
+        *pairs++ = pair_of(group_list[i], group_list[j]);
       }
     }
   }
-  reduced.resize(reduced_size, reduced_size);
-  reduced.setFromTriplets(triplets.begin(), triplets.end());
-  reduced.makeCompressed();
-  reduced_value_source.resize(reduced.nonZeros());
-  for (Eigen::Index k = 0; k < reduced.nonZeros(); ++k) {
-    reduced_value_source[k] = static_cast<size_t>(reduced.valuePtr()[k]);
+  // The upper triangle of the reduced system in CSC form, with the pair
+  // value behind each entry. Column j of group h holds the rows of the pair
+  // blocks (g, h), g < h, in increasing g (their group offsets increase with
+  // g), then rows 0..j of (h, h): pair_blocks are sorted by (g, h), and a
+  // stable pass by h lists each column group's blocks in that order. Built
+  // directly, on all threads over the column groups (Eigen's
+  // setFromTriplets sorted 10^6 triplets on one thread, to the same
+  // matrix). The values are the source indices until CopyReducedValues.
+  std::vector<size_t> column_blocks_begin(num_groups + 1, 0);
+  for (const PairBlock& pair : pair_blocks) {
+    ++column_blocks_begin[pair.col_group + 1];
   }
+  for (int h = 0; h < num_groups; ++h) {
+    column_blocks_begin[h + 1] += column_blocks_begin[h];
+  }
+  std::vector<int> column_blocks(pair_blocks.size());
+  {
+    std::vector<size_t> next_block(column_blocks_begin.begin(),
+                                   column_blocks_begin.end() - 1);
+    for (size_t b = 0; b < pair_blocks.size(); ++b) {
+      column_blocks[next_block[pair_blocks[b].col_group]++] =
+          static_cast<int>(b);
+    }
+  }
+  // Entries before each column group's first column, and per column of
+  // group h the rows of its off-diagonal blocks.
+  std::vector<int64_t> group_entries_begin(num_groups + 1, 0);
+  std::vector<int64_t> off_diagonal_rows(num_groups, 0);
+  for (int h = 0; h < num_groups; ++h) {
+    for (size_t k = column_blocks_begin[h]; k < column_blocks_begin[h + 1];
+         ++k) {
+      const PairBlock& pair = pair_blocks[column_blocks[k]];
+      if (pair.row_group != h) {
+        off_diagonal_rows[h] += groups[pair.row_group].size;
+      }
+    }
+    const int64_t size = groups[h].size;
+    group_entries_begin[h + 1] = group_entries_begin[h] +
+                                 size * off_diagonal_rows[h] +
+                                 size * (size + 1) / 2;
+  }
+  reduced.resize(reduced_size, reduced_size);
+  reduced.resizeNonZeros(
+      static_cast<Eigen::Index>(group_entries_begin[num_groups]));
+  reduced_value_source.resize(group_entries_begin[num_groups]);
+  int* outer = reduced.outerIndexPtr();
+  int* inner = reduced.innerIndexPtr();
+  double* values = reduced.valuePtr();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(NumThreads())
+  for (int h = 0; h < num_groups; ++h) {
+    const Group& column_group = groups[h];
+    int64_t entry = group_entries_begin[h];
+    for (int j = 0; j < column_group.size; ++j) {
+      outer[column_group.offset + j] = static_cast<int>(entry);
+      for (size_t k = column_blocks_begin[h]; k < column_blocks_begin[h + 1];
+           ++k) {
+        const PairBlock& pair = pair_blocks[column_blocks[k]];
+        const Group& row_group = groups[pair.row_group];
+        const int num_rows = pair.row_group == h ? j + 1 : row_group.size;
+        for (int i = 0; i < num_rows; ++i, ++entry) {
+          inner[entry] = row_group.offset + i;
+          reduced_value_source[entry] =
+              pair.offset + static_cast<size_t>(i) * column_group.size + j;
+          values[entry] = static_cast<double>(reduced_value_source[entry]);
+        }
+      }
+    }
+  }
+  outer[reduced_size] = static_cast<int>(group_entries_begin[num_groups]);
   pattern_analyzed = false;
 
   // Point chunks: consecutive points of about equal residual counts.
@@ -1093,7 +1166,7 @@ void BundleLevenbergMarquardt::Impl::EliminatePoints(Invert invert,
 }
 
 void BundleLevenbergMarquardt::Impl::CopyReducedValues() {
-  const std::vector<double>& s = reduced_values;
+  const LargeVector<double>& s = reduced_values;
   double* values = reduced.valuePtr();
   const int64_t num_values = static_cast<int64_t>(reduced_value_source.size());
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
@@ -1131,7 +1204,7 @@ bool BundleLevenbergMarquardt::Impl::ComputeStep(double mu,
       },
       &rhs);
   // S += D / mu.
-  std::vector<double>& s = reduced_values;
+  LargeVector<double>& s = reduced_values;
   for (size_t g = 0; g < groups.size(); ++g) {
     const Group& group = groups[g];
     for (int i = 0; i < group.size; ++i) {
@@ -1250,20 +1323,32 @@ void BundleLevenbergMarquardt::Reserve(size_t num_residual_blocks,
                                        size_t num_points) {
   impl_->residuals.reserve(num_residual_blocks);
   impl_->points.reserve(num_points);
-  impl_->point_index.reserve(num_points);
 }
 
 void BundleLevenbergMarquardt::AddPoint(double* values) {
-  impl_->structure_valid = false;
-  impl_->point_index.emplace(values, static_cast<int>(impl_->points.size()));
-  impl_->points.push_back(values);
-  impl_->point_held.push_back(0);
+  Impl& impl = *impl_;
+  impl.structure_valid = false;
+  if (impl.points_contiguous && !impl.points.empty() &&
+      values != impl.points.back() + 3) {
+    // The first point out of line: every point by hash from now on (the
+    // first of two with the same address keeps it).
+    impl.points_contiguous = false;
+    impl.point_index.reserve(impl.points.capacity());
+    for (size_t p = 0; p < impl.points.size(); ++p) {
+      impl.point_index.emplace(impl.points[p], static_cast<int>(p));
+    }
+  }
+  if (!impl.points_contiguous) {
+    impl.point_index.emplace(values, static_cast<int>(impl.points.size()));
+  }
+  impl.points.push_back(values);
+  impl.point_held.push_back(0);
 }
 
 void BundleLevenbergMarquardt::SetPointHeld(const double* values, bool held) {
-  const auto point = impl_->point_index.find(values);
-  CHECK(point != impl_->point_index.end()) << "not a point of the problem";
-  impl_->point_held[point->second] = held ? 1 : 0;
+  const int point = impl_->PointIndex(values);
+  CHECK_GE(point, 0) << "not a point of the problem";
+  impl_->point_held[point] = held ? 1 : 0;
 }
 
 void BundleLevenbergMarquardt::SetResidualBlockActive(size_t index,
@@ -1290,25 +1375,30 @@ size_t BundleLevenbergMarquardt::AddResidualBlock(
   for (int k = 0; k < residual.num_parameters; ++k) {
     residual.parameters[k] = parameters[k];
     residual.block[k] = -1;
-    // Consecutive residuals mostly share their blocks (one image's).
+    residual.jacobian_columns[k] = cost->parameter_block_sizes()[k];
+    // Consecutive residuals mostly share their blocks (one image's), and a
+    // point is never a block.
     std::pair<const double*, int>& cached = impl_->last_block[k];
+    int point = -1;
     if (cached.first != parameters[k]) {
-      const auto block = impl_->block_index.find(parameters[k]);
+      point = impl_->PointIndex(parameters[k]);
+      const auto block = point < 0 ? impl_->block_index.find(parameters[k])
+                                   : impl_->block_index.end();
       cached = {parameters[k],
                 block != impl_->block_index.end() ? block->second : -1};
+    } else if (cached.second < 0) {
+      point = impl_->PointIndex(parameters[k]);
     }
-    residual.jacobian_columns[k] = cost->parameter_block_sizes()[k];
     if (cached.second >= 0) {
       CHECK_EQ(impl_->blocks[cached.second].size,
                cost->parameter_block_sizes()[k]);
       residual.block[k] = cached.second;
       continue;
     }
-    const auto point = impl_->point_index.find(parameters[k]);
-    if (point != impl_->point_index.end()) {
+    if (point >= 0) {
       CHECK_EQ(cost->parameter_block_sizes()[k], 3);
       CHECK_LT(residual.point, 0) << "two points in one residual block";
-      residual.point = point->second;
+      residual.point = point;
       residual.point_parameter = k;
     }
   }

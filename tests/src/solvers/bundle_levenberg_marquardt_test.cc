@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <atomic>
 #include <memory>
 #include <random>
@@ -191,11 +192,21 @@ void BuildProblem(Scene* scene, Problem* problem, bool ambient_only = false) {
 // The problem over `scene` (BuildProblem) in `solver`, with `loss`: every
 // rig pose but the first, camera 0's intrinsics, camera 1's cam_from_rig
 // and intrinsics (principal point held) refined, and the points that are
-// not fixed.
+// not fixed. `point_values` (per point, null: scene->points) puts the
+// refined points' values elsewhere.
 void AddToSolver(Scene* scene, Problem* problem,
                  const ceres::LossFunction* loss,
-                 BundleLevenbergMarquardt* solver, bool ambient_only = false) {
+                 BundleLevenbergMarquardt* solver, bool ambient_only = false,
+                 const std::vector<double*>* point_values = nullptr) {
   BuildProblem(scene, problem, ambient_only);
+  const auto values_of = [&](int p) {
+    return point_values != nullptr ? (*point_values)[p]
+                                   : scene->points[p].data();
+  };
+  for (size_t k = 0; k < problem->parameters.size(); ++k) {
+    const int p = scene->observations[k].point;
+    if (p >= Scene::kNumFixedPoints) problem->parameters[k][3] = values_of(p);
+  }
   int group = 0;
   for (int j = 1; j < Scene::kNumFramesets; ++j) {
     solver->AddParameterBlock(scene->rig_from_world[j].data(), 7,
@@ -207,7 +218,7 @@ void AddToSolver(Scene* scene, Problem* problem,
   solver->AddParameterBlock(scene->intrinsics[1].data(), 4,
                             &problem->principal_point_held, group++);
   for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
-    solver->AddPoint(scene->points[p].data());
+    solver->AddPoint(values_of(p));
   }
   for (size_t k = 0; k < problem->costs.size(); ++k) {
     solver->AddResidualBlock(problem->costs[k].get(), loss,
@@ -404,6 +415,72 @@ TEST(BundleLevenbergMarquardtTest, ResultDoesNotDependOnThreadCount) {
     EXPECT_EQ(one.intrinsics, other->intrinsics);
     EXPECT_EQ(one.points, other->points);
   }
+}
+
+// The solver finds a point by its address by arithmetic while the points
+// lie 3 doubles apart (a std::vector<Eigen::Vector3d>), else by hash from
+// the first that does not: the same solve, bit for bit, with the refined
+// points in one vector or their second half 4 doubles apart, and
+// SetPointHeld finds a point of either half.
+TEST(BundleLevenbergMarquardtTest, PointsAnywhereInMemoryGiveTheSameSolve) {
+  const Scene truth = MakeScene(0.5, 0.1, 31);
+  const Scene start = Perturbed(truth, 32);
+  ceres::CauchyLoss loss(1.0);
+  BundleSolverOptions options;
+  options.parameter_tolerance = 1e-12;
+  options.function_tolerance = 1e-12;
+  const int middle = (Scene::kNumFixedPoints + Scene::kNumPoints) / 2;
+  const std::array<int, 2> held = {Scene::kNumFixedPoints + 3,
+                                   Scene::kNumPoints - 3};
+
+  Scene in_one_vector = start;
+  {
+    Problem problem;
+    BundleLevenbergMarquardt solver(options);
+    AddToSolver(&in_one_vector, &problem, &loss, &solver);
+    for (const int p : held) {
+      solver.SetPointHeld(in_one_vector.points[p].data(), true);
+    }
+    BundleSolverSummary summary;
+    solver.Solve(&summary);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
+  }
+
+  Scene split = start;
+  std::vector<Eigen::Vector3d> first_half;
+  std::vector<std::array<double, 4>> second_half;
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    const Eigen::Vector3d& x = split.points[p];
+    if (p < middle) {
+      first_half.push_back(x);
+    } else {
+      second_half.push_back({x.x(), x.y(), x.z(), 0});
+    }
+  }
+  std::vector<double*> point_values(Scene::kNumPoints, nullptr);
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    point_values[p] = p < middle ? first_half[p - Scene::kNumFixedPoints].data()
+                                 : second_half[p - middle].data();
+  }
+  {
+    Problem problem;
+    BundleLevenbergMarquardt solver(options);
+    AddToSolver(&split, &problem, &loss, &solver, /*ambient_only=*/false,
+                &point_values);
+    for (const int p : held) solver.SetPointHeld(point_values[p], true);
+    BundleSolverSummary summary;
+    solver.Solve(&summary);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
+  }
+  for (int p = Scene::kNumFixedPoints; p < Scene::kNumPoints; ++p) {
+    split.points[p] = Eigen::Vector3d(point_values[p]);
+  }
+  EXPECT_EQ(split.rig_from_world, in_one_vector.rig_from_world);
+  EXPECT_EQ(split.cam_from_rig, in_one_vector.cam_from_rig);
+  EXPECT_EQ(split.intrinsics, in_one_vector.intrinsics);
+  EXPECT_EQ(split.points, in_one_vector.points);
+  for (const int p : held) EXPECT_EQ(split.points[p], start.points[p]);
+  EXPECT_NE(split.points[held[0] + 1], start.points[held[0] + 1]);
 }
 
 TEST(BundleLevenbergMarquardtTest, UnusableStartFailsAndLeavesValues) {
