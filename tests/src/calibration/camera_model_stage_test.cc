@@ -9,7 +9,7 @@
 #include "tests/src/calibration/final_ba_scene.h"
 
 namespace rig_calibrator {
-namespace {
+namespace camera_model_stage_test {
 
 bool HasDiagnostic(const PipelineReport& report, const std::string& code,
                    int camera) {
@@ -78,5 +78,5 @@ TEST(CameraModelStage, CheckCameraModelsReportsTheSameOnAnyThreadCount) {
   }
 }
 
-}  // namespace
+}  // namespace camera_model_stage_test
 }  // namespace rig_calibrator

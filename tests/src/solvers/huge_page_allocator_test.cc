@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace rig_calibrator {
-namespace {
+namespace huge_page_allocator_test {
 
 bool HugePageAligned(const void* memory) {
   return reinterpret_cast<uintptr_t>(memory) % kHugePageBytes == 0;
@@ -43,5 +43,5 @@ TEST(HugePageAllocatorTest, VectorKeepsItsValuesAcrossTheThreshold) {
   EXPECT_EQ(copy, values);
 }
 
-}  // namespace
+}  // namespace huge_page_allocator_test
 }  // namespace rig_calibrator
