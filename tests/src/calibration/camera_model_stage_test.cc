@@ -29,7 +29,7 @@ TEST(CameraModelStage, CheckCameraModelsReportsTheSameOnAnyThreadCount) {
   final_ba_testing::SceneOptions scene;
   scene.num_framesets = 10;
   scene.noise_px = 0.3;
-  final_ba_testing::SyntheticRig rig =
+  final_ba_testing::SyntheticBaScene rig =
       final_ba_testing::MakeSyntheticRig(scene);
   RigCalibration calibration = rig.truth;
   for (ImageResult& image : calibration.images) image.used = true;
