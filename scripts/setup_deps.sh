@@ -97,7 +97,7 @@ if [ -f "$stamp" ] && [ -x "$prefix/bin/colmap" ] && [ -f "$prefix/share/colmap/
   exit 0
 fi
 
-say "building COLMAP 3.8 from Debian's source package into $prefix (about 12 minutes on 2 cores)"
+say "building COLMAP 3.8 from Debian's source package into $prefix (about 9 minutes on 2 cores)"
 fetch_colmap_source
 
 # Ninja compiles the objects of COLMAP's libraries in any order (Make waits for
