@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs everything rig_calibrator needs on Debian 12 (bookworm) and builds COLMAP 3.8's
 # libraries, headers and command-line tool from Debian's source package into a cache prefix
-# outside the repository, keeping the unpacked source beside it ($cache/src/colmap-3.8: the
-# project's extended `colmap` compiles COLMAP's command sources from it). Idempotent: a rerun
-# with the cache in place skips the COLMAP build, and unpacks the source again if it is gone.
+# outside the repository ($cache/colmap-3.8). Beside COLMAP's own files the prefix gets
+# lib/colmap/libcolmap_commands.a: the objects COLMAP compiled for its command line (src/exe),
+# with colmap.cc's `main` renamed `ColmapMain`, from which the project's extended `colmap` is
+# linked. Idempotent: a rerun with the cache in place skips the COLMAP build; a cache made
+# before that archive existed gets it from COLMAP's build folder, or is built again.
 #
 # Environment:
 #   RIG_CALIBRATOR_CACHE  cache folder (default: $HOME/.cache/rig_calibrator)
@@ -28,7 +30,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 
 packages=(
-  build-essential cmake ninja-build git pkg-config dpkg-dev ca-certificates
+  build-essential binutils cmake ninja-build git pkg-config dpkg-dev ca-certificates
   libeigen3-dev libceres-dev libgoogle-glog-dev libgflags-dev libflann-dev
   libfreeimage-dev libmetis-dev libsqlite3-dev libglew-dev libsuitesparse-dev liblz4-dev
   libboost-program-options-dev libboost-filesystem-dev libboost-graph-dev
@@ -70,8 +72,7 @@ for tool in g++ cmake ninja; do
   command -v "$tool" >/dev/null 2>&1 || die "'$tool' not found after installing packages."
 done
 
-# COLMAP's source tree stays in the cache after the build: the project's
-# `colmap` executable compiles COLMAP's own command sources (src/exe) from it.
+# COLMAP's source tree, unpacked into the cache; its build folder inside it.
 src_root="$cache/src"
 src="$src_root/colmap-3.8"
 fetch_colmap_source() {
@@ -91,10 +92,50 @@ SRC
     || die "COLMAP source not found in $src."
 }
 
+# The build folder stays in the cache: its src/exe objects make the archive
+# below.
+build="$src/build-rig-calibrator"
+commands_archive="$prefix/lib/colmap/libcolmap_commands.a"
+exe_objects="$build/src/exe/CMakeFiles/colmap_exe.dir"
+# The sources of COLMAP's command line other than feature.cc and sfm.cc, which
+# libcolmap.a already holds (COLMAP_ADD_SOURCES in its src/exe/CMakeLists.txt).
+command_sources=(colmap database gui image model mvs vocab_tree)
+
+# libcolmap_commands.a from the objects of COLMAP's own `colmap`: compiled once,
+# by COLMAP's build with COLMAP's flags, instead of again by the project's.
+# colmap.cc's `main` becomes `ColmapMain` (colmap_ext/commands/colmap_main.cc
+# calls it). False when the objects are gone.
+archive_colmap_commands() {
+  local work="$build/rig_calibrator_commands" name objects=()
+  for name in "${command_sources[@]}"; do
+    [ -f "$exe_objects/$name.cc.o" ] || return 1
+  done
+  rm -rf "$work"
+  mkdir -p "$work"
+  for name in "${command_sources[@]}"; do
+    cp "$exe_objects/$name.cc.o" "$work/colmap_$name.o"
+    objects+=("$work/colmap_$name.o")
+  done
+  objcopy --redefine-sym main=ColmapMain "$work/colmap_colmap.o" \
+    || die "objcopy could not rename main in $exe_objects/colmap.cc.o."
+  nm "$work/colmap_colmap.o" | grep -q ' T ColmapMain$' \
+    || die "no ColmapMain in $work/colmap_colmap.o after renaming main."
+  rm -f "$commands_archive.tmp"
+  ar rcs "$commands_archive.tmp" "${objects[@]}" && mv "$commands_archive.tmp" "$commands_archive"
+  rm -rf "$work"
+}
+
 if [ -f "$stamp" ] && [ -x "$prefix/bin/colmap" ] && [ -f "$prefix/share/colmap/COLMAPConfig.cmake" ]; then
-  fetch_colmap_source
-  say "COLMAP 3.8 found in cache $prefix (source in $src): skipping its build"
-  exit 0
+  if [ -f "$commands_archive" ]; then
+    say "COLMAP 3.8 found in cache $prefix: skipping its build"
+    exit 0
+  fi
+  if archive_colmap_commands; then
+    say "COLMAP 3.8 found in cache $prefix: archived its command objects in $commands_archive"
+    exit 0
+  fi
+  say "the cache $prefix has no $commands_archive and COLMAP's objects are gone: building again"
+  rm -f "$stamp"
 fi
 
 say "building COLMAP 3.8 from Debian's source package into $prefix (about 9 minutes on 2 cores)"
@@ -102,7 +143,6 @@ fetch_colmap_source
 
 # Ninja compiles the objects of COLMAP's libraries in any order (Make waits for
 # each library before the next one's objects), which keeps both cores busy.
-build="$src/build-rig-calibrator"
 # A folder left by an unfinished build with another generator starts afresh.
 grep -qs '^CMAKE_GENERATOR:INTERNAL=Ninja$' "$build/CMakeCache.txt" || rm -rf "$build"
 mkdir -p "$build"
@@ -113,5 +153,6 @@ cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_
 cmake --build "$build" -j"$jobs" --target install > "$build/build.log" 2>&1 \
   || { tail -n 40 "$build/build.log"; die "building COLMAP failed (log: $build/build.log)."; }
 "$prefix/bin/colmap" help > /dev/null 2>&1 || die "the freshly built colmap does not run."
+archive_colmap_commands || die "COLMAP's command objects are missing in $exe_objects."
 date -u +%FT%TZ > "$stamp"
 say "COLMAP 3.8 installed in $prefix"

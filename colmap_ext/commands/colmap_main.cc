@@ -4,9 +4,9 @@
 //   colmap rig_calibrator [calibrate|evaluate|...] ...   rig_calibrator's
 //   colmap help                                          both lists
 //
-// COLMAP's commands are COLMAP's own command table: its src/exe/colmap.cc,
-// compiled from the COLMAP 3.8 source tree with its `main` renamed ColmapMain
-// (colmap_ext/CMakeLists.txt). Only `rig_calibrator` and the help are
+// COLMAP's commands are COLMAP's own command table: its src/exe/colmap.cc as
+// COLMAP's build compiled it, with its `main` renamed ColmapMain
+// (scripts/setup_deps.sh, colmap_ext/CMakeLists.txt). Only `rig_calibrator` and the help are
 // handled here; everything else, unknown commands included, goes to
 // ColmapMain unchanged.
 #include <iostream>
@@ -16,8 +16,9 @@
 #include "colmap_ext/commands/colmap_help.h"
 #include "colmap_ext/commands/rig_calibrator_command.h"
 
-// COLMAP's main (src/exe/colmap.cc compiled with -Dmain=ColmapMain).
-int ColmapMain(int argc, char** argv);
+// COLMAP's main (src/exe/colmap.cc), renamed by objcopy: like `main`, its
+// symbol is the plain name, not a C++ mangled one.
+extern "C" int ColmapMain(int argc, char** argv);
 
 int main(int argc, char** argv) {
   const std::string command = argc > 1 ? argv[1] : "";
