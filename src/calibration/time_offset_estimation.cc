@@ -138,7 +138,7 @@ bool InterpolateSpeed(const std::vector<ChordSpeed>& speeds, double t,
   return true;
 }
 
-// Step 1 of the header: the offset minimizing the robust speed mismatch.
+// Step 2 of the header: the offset minimizing the robust speed mismatch.
 // False (offset 0) if the reference's angular speed hardly varies or the
 // series do not overlap.
 bool CoarseOffset(const std::vector<ChordSpeed>& camera,
@@ -194,14 +194,15 @@ bool CoarseOffset(const std::vector<ChordSpeed>& camera,
   return true;
 }
 
-// Step 2's result for one camera.
+// Step 1's result for one camera.
 struct InitialCamera {
   Rigid3d cam_from_rig;
   std::vector<char> consistent;  // per frameset: pair consistent with the reference
 };
 
-// Step 2 of the header. rotation_tolerance, position_tolerance_base: the
-// rig's motion during the offset (the lever arm term is added here).
+// Step 1 of the header. rotation_tolerance, position_tolerance_base: the
+// rig's motion during the offset plus the noise (the lever arm term is added
+// here).
 InitialCamera InitializeCamera(
     const std::vector<std::optional<Rigid3d>>& camera,
     const std::vector<std::optional<Rigid3d>>& reference,
@@ -674,7 +675,7 @@ bool EstimateTimeOffsets(const TimeOffsetProblem& problem,
   for (int f = 0; f + 1 < num_framesets; ++f) intervals.push_back(times[f + 1] - times[f]);
   const double frame_interval = colmap::Median(intervals);
 
-  // Pass 1 of step 2, before any offset is known (|delta_c| <= the search
+  // Step 1, first pass, before any offset is known (|delta_c| <= the search
   // range): the poses consistent with another camera's in their frameset.
   const RigSpeeds rig_speeds =
       HighRigSpeeds(times, problem.cam_from_world, options);
@@ -700,7 +701,7 @@ bool EstimateTimeOffsets(const TimeOffsetProblem& problem,
   }
   if (num_cameras == 1) trusted[ref] = reference;
 
-  // Step 1 on the trusted poses, then pass 2 of step 2 with the coarse
+  // Step 2 on the trusted poses, then step 1's second pass with the coarse
   // offsets: cam_from_rig and the reference knots.
   const std::vector<ChordSpeed> reference_speeds =
       ChordSpeeds(times, trusted[ref], options.max_angular_speed_rad_s);
