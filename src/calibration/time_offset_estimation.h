@@ -72,7 +72,11 @@
 //     and Cov = (J^T J)^-1 of the whitened inlier residuals with respect to
 //     (rotation of cam_from_rig, p_c, delta_c). sigma(delta_c) = sqrt(Cov_77).
 //     The residual's noise is the camera's plus the interpolated reference's,
-//     both measured by the scales.
+//     both measured by the scales. sigma covers that noise, not the
+//     interpolation's own error: on exact data of a smooth walk at 5 Hz the
+//     offsets are off by 2-7 us with sigma about 1 us. With 0.05 deg / 5 mm
+//     noise, 20 % wrong and 10 % missing images, |error| / sigma over 120
+//     offsets had median 0.61-0.93 (0.674 expected) and at most 1 beyond 3.
 //
 // Observability. delta_c is identifiable only if the rig's motion is not a
 // constant screw: a shift in time of a constant angular and linear velocity
