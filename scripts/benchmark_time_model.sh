@@ -65,8 +65,9 @@ results, presets = sys.argv[1], sys.argv[2:]
 cases = {"a": "synchronized, global shutter", "b": "offsets in +-50 ms",
          "c": "line delays 20-30 us/row", "d": "offsets and line delays"}
 rows = ["| preset | case | rotation (deg) | center (m) | focal (%) | principal point (px) "
-        "| projection, max (px) | reprojection RMS (px) | diagnostics |",
-        "|---|---|---|---|---|---|---|---|---|"]
+        "| projection, max (px) | reprojection RMS (px) | chosen model not the true one "
+        "| diagnostics |",
+        "|---|---|---|---|---|---|---|---|---|---|"]
 for preset in presets:
     for case, label in cases.items():
         folder = os.path.join(results, f"{preset}_{case}")
@@ -78,6 +79,13 @@ for preset in presets:
             camera = max(errors, key=lambda c: c[key])
             return f"{camera[key]:.3g} ({camera['name']})"
         rms = max(summary["cameras"], key=lambda c: c["rms_px"])
+        # The true models, as the synthetic command prints them for
+        # --RigCalibrator.camera_model: cam0:OPENCV,cam1:...
+        log = open(os.path.join(folder, "synthetic.log")).read()
+        true_models = dict(item.split(":") for item in
+                           re.search(r"camera_model (\S+)", log).group(1).split(","))
+        wrong_models = [f"{c['name']} {c['model']}" for c in summary["cameras"]
+                        if c["model"] != true_models[c["name"]]]
         # Diagnostics are "LEVEL CODE: message" (notes have no level); the
         # cameras a message names are given with its code.
         found = {}
@@ -96,6 +104,7 @@ for preset in presets:
                     f"| {worst('principal_point_error_px')} "
                     f"| {worst('max_projection_diff_px')} "
                     f"| {rms['rms_px']:.3g} ({rms['name']}) "
+                    f"| {', '.join(wrong_models) or 'none'} "
                     f"| {', '.join(codes) or 'none'} |")
         print(f"{preset} ({case}): offsets ms {', '.join(f'{o:.1f}' for o in offsets)}; "
               f"line delays us {', '.join(f'{d:.1f}' for d in delays)}")

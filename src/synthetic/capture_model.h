@@ -63,18 +63,21 @@ Rigid3d RigFromWorldAtTime(const RigGroundTruth& truth, double time_s);
 ImageCapture CaptureOfImage(const RigGroundTruth& truth, int camera,
                             int frameset);
 
+// The rolling-shutter iteration stops when two iterates agree to this, or
+// fails after that many iterations.
+constexpr double kRollingShutterTolerancePx = 1e-10;
+constexpr int kMaxRollingShutterIterations = 50;
+
 // The pixel (x, y) = pi(cam_from_world(t(y)) X) of the world point X, by the
-// fixed-point iteration above from the projection at the middle row's time,
+// fixed-point iteration above, started at the middle row (y = height / 2),
 // until two iterates agree to kRollingShutterTolerancePx. False when an
-// iterate is behind the camera or not finite, or after kMaxRollingShutter
-// Iterations without convergence. The pixel may lie outside the image (the
+// iterate is behind the camera or not finite, or without convergence after
+// kMaxRollingShutterIterations. The pixel may lie outside the image (the
 // caller decides).
 bool ProjectWithRollingShutter(const colmap::Camera& camera,
                                const ImageCapture& capture,
                                const Eigen::Vector3d& point_in_world,
                                Eigen::Vector2d* xy);
 
-constexpr double kRollingShutterTolerancePx = 1e-10;
-constexpr int kMaxRollingShutterIterations = 50;
 
 }  // namespace rig_calibrator
