@@ -3,6 +3,7 @@
 // feed benchmarks without images.
 #include <boost/filesystem.hpp>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "colmap_ext/benchmarks/synthetic_map_model.h"
 #include "colmap_ext/commands/command_options.h"
@@ -29,6 +30,41 @@ RigDescription DescribeGroundTruth(const RigGroundTruth& truth) {
     rig.cameras.push_back(camera);
   }
   return rig;
+}
+
+// ground_truth/time_model.json of a dataset with a time model: the
+// frameset rate, the rig's speed and turn rate, per camera its capture-time
+// offset and line delay, and per frameset its time (seconds); camera c
+// captures the row through pixel y of frameset f at
+// frameset_times_s[f] + time_offset_s + line_delay_s (y - 0.5).
+bool WriteTimeModelJson(const std::string& path,
+                        const SyntheticRigOptions& options,
+                        const RigDataset& dataset,
+                        const RigGroundTruth& truth, std::string* error) {
+  nlohmann::ordered_json json;
+  json["capture_time"] =
+      "camera c captures the row through pixel y (COLMAP pixels, the top "
+      "row's centre at y = 0.5) of frameset f at frameset_times_s[f] + "
+      "time_offset_s + line_delay_s * (y - 0.5) seconds";
+  json["frameset_rate_hz"] = options.frameset_rate_hz;
+  json["speed_m_s"] = options.speed_m_s;
+  json["max_turn_rate_deg_s"] = options.max_turn_rate_deg_s;
+  json["reference_camera"] = truth.camera_names[0];
+  nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
+  for (size_t c = 0; c < truth.cameras.size(); ++c) {
+    cameras.push_back({{"name", truth.camera_names[c]},
+                       {"time_offset_s", truth.time_offsets_s[c]},
+                       {"line_delay_s", truth.line_delays_s[c]},
+                       {"rows", truth.cameras[c].Height()}});
+  }
+  json["cameras"] = cameras;
+  nlohmann::ordered_json framesets = nlohmann::ordered_json::array();
+  for (size_t f = 0; f < truth.frameset_times_s.size(); ++f) {
+    framesets.push_back({{"name", dataset.frameset_names[f]},
+                         {"time_s", truth.frameset_times_s[f]}});
+  }
+  json["framesets"] = framesets;
+  return WriteFileAtomically(path, json.dump(2) + "\n", error);
 }
 
 }  // namespace
@@ -75,6 +111,8 @@ int RunSynthetic(int argc, char** argv) {
             "pixel noise of the map images' observations");
   AddOption(&description, "map_point_noise", &options.map_point_noise,
             "error of the map points (map units per coordinate)");
+  TimeModelArguments time_model;
+  AddTimeModelOptions(&description, &options, &time_model);
   AddOption(&description, "seed", &seed, "random seed");
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(
@@ -90,7 +128,8 @@ int RunSynthetic(int argc, char** argv) {
   }
   options.seed = static_cast<unsigned int>(seed);
   std::string error;
-  if (!options.Check(&error)) {
+  if (!ApplyTimeModelArguments(time_model, &options, &error) ||
+      !options.Check(&error)) {
     return PrintError(error);
   }
   const SyntheticRig rig = GenerateSyntheticRig(options);
@@ -114,7 +153,11 @@ int RunSynthetic(int argc, char** argv) {
                WriteRigConfigJson(folder + "/ground_truth/rig_config.json",
                                   truth, write_error) &&
                WriteCamchainYaml(folder + "/ground_truth/camchain.yaml", truth,
-                                 &notes, write_error);
+                                 &notes, write_error) &&
+               (options.frameset_rate_hz == 0 ||
+                WriteTimeModelJson(folder + "/ground_truth/time_model.json",
+                                   options, rig.dataset, rig.truth,
+                                   write_error));
       },
       &error);
   if (!written) {
@@ -129,6 +172,9 @@ int RunSynthetic(int argc, char** argv) {
             << rig.truth.cameras.size() << " cameras in "
             << rig.dataset.frameset_names.size() << " framesets (" << preset
             << ") to " << output_path
+            << (options.frameset_rate_hz > 0
+                    ? " (time model in ground_truth/time_model.json)"
+                    : "")
             << "\nCalibrate with:\n  rig_calibrator --correspondences_path "
             << output_path << "/correspondences.txt "
             << (options.num_map_images > 0

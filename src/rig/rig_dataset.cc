@@ -1,5 +1,7 @@
 #include "src/rig/rig_dataset.h"
 
+#include <cmath>
+
 namespace rig_calibrator {
 namespace {
 
@@ -58,6 +60,24 @@ bool ValidateDataset(const RigDataset& dataset, std::string* error) {
                " has no image size or invalid parameters for model " +
                camera.camera.ModelName();
       return false;
+    }
+  }
+  if (!dataset.frameset_times_s.empty()) {
+    if (dataset.frameset_times_s.size() != dataset.frameset_names.size()) {
+      *error = "the dataset has " +
+               std::to_string(dataset.frameset_times_s.size()) +
+               " frameset times for " +
+               std::to_string(dataset.frameset_names.size()) + " framesets";
+      return false;
+    }
+    for (size_t f = 0; f < dataset.frameset_times_s.size(); ++f) {
+      const double time = dataset.frameset_times_s[f];
+      if (!std::isfinite(time) ||
+          (f > 0 && !(time > dataset.frameset_times_s[f - 1]))) {
+        *error = "the time of frameset " + dataset.frameset_names[f] +
+                 " is not finite or not after the previous frameset's";
+        return false;
+      }
     }
   }
   for (const RigImage& image : dataset.images) {

@@ -70,6 +70,11 @@ struct MapImage {
 struct RigDataset {
   std::vector<RigCamera> cameras;
   std::vector<std::string> frameset_names;  // one per frameset
+  // Per frameset its nominal capture time (seconds, any origin; strictly
+  // increasing), or empty when unknown (every source but the synthetic
+  // generator's time model): the clock that per-camera time offsets and
+  // line delays are relative to.
+  std::vector<double> frameset_times_s;
   std::vector<RigImage> images;
   int reference_camera = 0;  // its cam_from_rig is the identity
   // The map's cameras and images (empty when there is no map, e.g. a run
@@ -118,7 +123,8 @@ struct RigCalibration {
 // The one check of a calibration problem, whatever its source: at least two
 // cameras, a valid reference camera, every camera with an image size and
 // parameters valid for its model, every image with a valid camera and
-// frameset, and finite correspondences; every map image with a valid map
+// frameset, and finite correspondences; frameset times empty or one finite
+// value per frameset, strictly increasing; every map image with a valid map
 // camera, a finite pose and finite observations of points in map_points3D.
 // Returns false with `error` naming the camera or image and what is wrong.
 bool ValidateDataset(const RigDataset& dataset, std::string* error);

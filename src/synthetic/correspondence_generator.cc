@@ -46,13 +46,44 @@ bool ProjectIntoImage(const colmap::Camera& camera,
 
 }  // namespace
 
+CameraPose::CameraPose(const Rigid3d& cam_from_world)
+    : cam_from_world(cam_from_world) {
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+  center = world_from_cam.translation;
+  world_from_cam_rotation = world_from_cam.RotationMatrix();
+}
+
+CameraPose ImageContext::PoseOfRow(double y) const {
+  if (!rolling_shutter) return pose;
+  return CameraPose(
+      rolling_shutter->CamFromWorldAt(rolling_shutter->RowTime(y)));
+}
+
+bool ImageContext::PointInCamera(const Eigen::Vector3d& point_in_world,
+                                 Eigen::Vector3d* point_in_camera) const {
+  if (!rolling_shutter) {
+    *point_in_camera = pose.cam_from_world * point_in_world;
+    return true;
+  }
+  Eigen::Vector2d xy;
+  if (!ProjectWithRollingShutter(*camera, *rolling_shutter, point_in_world,
+                                 &xy)) {
+    return false;
+  }
+  *point_in_camera = rolling_shutter->CamFromWorldAt(
+                         rolling_shutter->RowTime(xy.y())) *
+                     point_in_world;
+  return true;
+}
+
 bool PointGenerator::NewVisiblePoint(const ImageContext& image, int frameset,
                                      int64_t* point3D_id, Eigen::Vector2d* xy) {
   std::uniform_real_distribution<double> unit(0, 1);
   const bool on_plane = unit(*rng_) < options_.near_planar_ratio;
   for (int attempt = 0; attempt < kMaxSampleAttempts; ++attempt) {
+    CameraPose row_pose;
     Eigen::Vector3d ray_in_world;
-    if (!RandomRay(image, &ray_in_world)) {
+    if (!RandomRay(image, &row_pose, &ray_in_world)) {
       continue;
     }
     double distance = 0;
@@ -61,7 +92,7 @@ bool PointGenerator::NewVisiblePoint(const ImageContext& image, int frameset,
       if (ray_in_world.z() >= -1e-9) {
         continue;
       }
-      distance = -image.center.z() / ray_in_world.z();
+      distance = -row_pose.center.z() / ray_in_world.z();
       if (distance < options_.min_depth || distance > options_.max_depth) {
         continue;
       }
@@ -69,8 +100,12 @@ bool PointGenerator::NewVisiblePoint(const ImageContext& image, int frameset,
       distance = std::uniform_real_distribution<double>(
           options_.min_depth, options_.max_depth)(*rng_);
     }
-    const Eigen::Vector3d point = image.center + distance * ray_in_world;
-    if (!ProjectIntoImage(*image.camera, image.cam_from_world * point, xy) ||
+    const Eigen::Vector3d point = row_pose.center + distance * ray_in_world;
+    // With a rolling shutter the point is on the ray of its pixel at that
+    // row's pose, so this projection (by the same pose) is the fixed point
+    // of capture_model.h up to rounding.
+    if (!ProjectIntoImage(*image.camera, row_pose.cam_from_world * point,
+                          xy) ||
         !image.InWindow(*xy)) {
       continue;
     }
@@ -89,7 +124,10 @@ void PointGenerator::TrackPoints(const ImageContext& image, int frameset,
     if (static_cast<int>(point3D_ids->size()) >= count) {
       break;
     }
-    const Eigen::Vector3d point_in_camera = image.cam_from_world * points_[id];
+    Eigen::Vector3d point_in_camera;
+    if (!image.PointInCamera(points_[id], &point_in_camera)) {
+      continue;
+    }
     const double distance = point_in_camera.norm();
     Eigen::Vector2d xy;
     if (distance < options_.min_depth || distance > options_.max_depth ||
@@ -148,7 +186,8 @@ std::vector<int64_t> PointGenerator::RecentPoints(int frameset) const {
 bool PointGenerator::IsWrongFor(const ImageContext& image,
                                 const Eigen::Vector3d& point,
                                 const Eigen::Vector2d& xy) const {
-  const Eigen::Vector3d point_in_camera = image.cam_from_world * point;
+  const Eigen::Vector3d point_in_camera =
+      image.PoseOfRow(xy.y()).cam_from_world * point;
   if (point_in_camera.z() <= 0) {
     return true;
   }
@@ -159,6 +198,7 @@ bool PointGenerator::IsWrongFor(const ImageContext& image,
 }
 
 bool PointGenerator::RandomRay(const ImageContext& image,
+                               CameraPose* row_pose,
                                Eigen::Vector3d* ray_in_world) {
   const colmap::Camera& camera = *image.camera;
   const double x = std::uniform_real_distribution<double>(
@@ -171,8 +211,9 @@ bool PointGenerator::RandomRay(const ImageContext& image,
   if (!std::isfinite(u) || !std::isfinite(v)) {
     return false;
   }
-  *ray_in_world =
-      image.world_from_cam_rotation * Eigen::Vector3d(u, v, 1).normalized();
+  *row_pose = image.PoseOfRow(y);
+  *ray_in_world = row_pose->world_from_cam_rotation *
+                  Eigen::Vector3d(u, v, 1).normalized();
   return true;
 }
 

@@ -8,21 +8,35 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <unordered_set>
 #include <vector>
 
 #include "src/geometry/rigid3d.h"
+#include "src/synthetic/capture_model.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
 
-// Everything the generator needs about one image.
-struct ImageContext {
-  const colmap::Camera* camera = nullptr;
+// A camera pose with what the generator derives from it.
+struct CameraPose {
+  CameraPose() = default;
+  explicit CameraPose(const Rigid3d& cam_from_world);
+
   Rigid3d cam_from_world;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // in the world
   Eigen::Matrix3d world_from_cam_rotation = Eigen::Matrix3d::Identity();
+};
+
+// Everything the generator needs about one image.
+struct ImageContext {
+  const colmap::Camera* camera = nullptr;
+  // The pose of every row (global shutter), or of the top row when the image
+  // has a rolling shutter.
+  CameraPose pose;
+  // A rolling shutter (capture_model.h): every row at its own time and pose.
+  std::optional<ImageCapture> rolling_shutter;
   // Pixel window holding the image's correspondences (feature_window).
   Eigen::Vector2d window_min = Eigen::Vector2d::Zero();
   Eigen::Vector2d window_max = Eigen::Vector2d::Zero();
@@ -31,6 +45,13 @@ struct ImageContext {
     return xy.x() >= window_min.x() && xy.y() >= window_min.y() &&
            xy.x() <= window_max.x() && xy.y() <= window_max.y();
   }
+  // The pose at which the row through pixel coordinate y is captured.
+  CameraPose PoseOfRow(double y) const;
+  // The point in the frame of the camera at the pose that observes it: the
+  // image's pose, or with a rolling shutter the pose of the row of its pixel
+  // (ProjectWithRollingShutter; false when that has no solution).
+  bool PointInCamera(const Eigen::Vector3d& point_in_world,
+                     Eigen::Vector3d* point_in_camera) const;
 };
 
 // The generator's state: the map points created so far, with the frameset
@@ -71,12 +92,14 @@ class PointGenerator {
   std::vector<int64_t> RecentPoints(int frameset) const;
 
   // Behind the camera, or projecting (wherever, even outside the image) far
-  // from xy.
+  // from xy, with the pose of xy's row: the residual of the correspondence.
   bool IsWrongFor(const ImageContext& image, const Eigen::Vector3d& point,
                   const Eigen::Vector2d& xy) const;
 
-  // The world direction of the ray through a uniformly random pixel.
-  bool RandomRay(const ImageContext& image, Eigen::Vector3d* ray_in_world);
+  // The world direction of the ray through a uniformly random pixel, and
+  // the pose of that pixel's row.
+  bool RandomRay(const ImageContext& image, CameraPose* row_pose,
+                 Eigen::Vector3d* ray_in_world);
 
   const SyntheticRigOptions& options_;
   std::mt19937* rng_;

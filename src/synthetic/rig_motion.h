@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "src/geometry/rigid3d.h"
-#include "src/synthetic/rig_presets.h"
+#include "src/synthetic/rig_trajectory.h"
 
 namespace rig_calibrator {
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "src/geometry/rigid3d.h"
+#include "src/synthetic/rig_trajectory.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
@@ -26,17 +27,6 @@ struct CameraSpec {
   double yaw_deg = 0;    // viewing direction about z, 0 = forward, 90 = left
   double pitch_deg = 0;  // positive = looking up
   double roll_deg = 0;   // about the viewing direction
-};
-
-// How the rig moves: a walk or a drive with sinusoidal yaw, pitch and roll
-// around a slowly turning heading (phases are drawn from the seed).
-struct MotionProfile {
-  double step_m = 0.4;    // distance between framesets
-  double height_m = 1.6;  // body origin above the ground
-  double bob_m = 0.03;
-  double yaw_amplitude_deg = 40, yaw_period = 25, yaw_rate_deg = 3;
-  double pitch_amplitude_deg = 8, pitch_period = 17;
-  double roll_amplitude_deg = 6, roll_period = 13;
 };
 
 struct PresetDefinition {

@@ -11,6 +11,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "src/synthetic/capture_model.h"
 #include "src/synthetic/correspondence_generator.h"
 #include "src/synthetic/rig_motion.h"
 #include "src/synthetic/rig_presets.h"
@@ -69,16 +70,21 @@ std::vector<RigCamera> InitialCameras(const RigGroundTruth& truth) {
 }
 
 // The generator's view of image (frameset j, camera c), with its feature
-// window drawn from *rng for partial windows.
+// window drawn from *rng for partial windows. With a time model the image is
+// taken at t_j + delta_c (its top row), its rows at their own poses with a
+// rolling shutter.
 ImageContext MakeImageContext(const SyntheticRigOptions& options,
                               const RigGroundTruth& truth, int j, int c,
                               std::mt19937* rng) {
   ImageContext context;
   context.camera = &truth.cameras[c];
-  context.cam_from_world = truth.cam_from_rig[c] * truth.rig_from_world[j];
-  const Rigid3d world_from_cam = context.cam_from_world.Inverse();
-  context.center = world_from_cam.translation;
-  context.world_from_cam_rotation = world_from_cam.RotationMatrix();
+  if (truth.trajectory) {
+    const ImageCapture capture = CaptureOfImage(truth, c, j);
+    context.pose = CameraPose(capture.CamFromWorldAt(capture.top_row_time_s));
+    if (capture.line_delay_s > 0) context.rolling_shutter = capture;
+  } else {
+    context.pose = CameraPose(truth.cam_from_rig[c] * truth.rig_from_world[j]);
+  }
   const Eigen::Vector2d size(context.camera->Width(), context.camera->Height());
   context.window_max = size;
   if (options.feature_window < 1) {
@@ -156,6 +162,43 @@ void GenerateImage(const SyntheticRigOptions& options,
   rig->is_outlier.push_back(std::move(shuffled_is_outlier));
 }
 
+// The time model of options.frameset_rate_hz > 0: the continuous
+// trajectory (its phases drawn from *rng, as the per-frameset trajectory's),
+// the frameset times and rig poses, and each camera's time offset and line
+// delay, given or drawn from a stream of their own (so that the offsets do
+// not change the rest of the data's draws).
+void AddTimeModel(const SyntheticRigOptions& options,
+                  const MotionProfile& motion, const Rigid3d& body_from_rig,
+                  std::mt19937* rng, RigGroundTruth* truth) {
+  truth->trajectory.emplace(motion, options.speed_m_s,
+                            options.max_turn_rate_deg_s, options.rotation_only,
+                            rng);
+  truth->body_from_rig = body_from_rig;
+  for (int f = 0; f < options.num_framesets; ++f) {
+    const double time_s = f / options.frameset_rate_hz;
+    truth->frameset_times_s.push_back(time_s);
+    truth->rig_from_world.push_back(RigFromWorldAtTime(*truth, time_s));
+  }
+  const int num_cameras = truth->cameras.size();
+  std::mt19937 time_rng(options.seed + 4);
+  std::uniform_real_distribution<double> offset(-options.max_time_offset_s,
+                                                options.max_time_offset_s);
+  std::uniform_real_distribution<double> line_delay(options.min_line_delay_s,
+                                                    options.max_line_delay_s);
+  truth->time_offsets_s = options.time_offsets_s;
+  if (truth->time_offsets_s.empty()) {
+    for (int c = 0; c < num_cameras; ++c) {
+      truth->time_offsets_s.push_back(c == 0 ? 0.0 : offset(time_rng));
+    }
+  }
+  truth->line_delays_s = options.line_delays_s;
+  if (truth->line_delays_s.empty()) {
+    for (int c = 0; c < num_cameras; ++c) {
+      truth->line_delays_s.push_back(line_delay(time_rng));
+    }
+  }
+}
+
 // Changes the map's unit (SyntheticRigOptions::map_scale): x' = s x for
 // every 3D point and translation; rotations and pixels stay.
 void ScaleMap(double scale, SyntheticRig* rig) {
@@ -166,6 +209,10 @@ void ScaleMap(double scale, SyntheticRig* rig) {
   }
   for (Rigid3d& pose : rig->truth.rig_from_world) pose.translation *= scale;
   for (Rigid3d& pose : rig->truth.cam_from_rig) pose.translation *= scale;
+  if (rig->truth.trajectory) {
+    rig->truth.trajectory->ScalePositions(scale);
+    rig->truth.body_from_rig.translation *= scale;
+  }
   for (MapImage& image : rig->dataset.map_images) {
     image.cam_from_world.translation *= scale;
   }
@@ -176,6 +223,105 @@ void ScaleMap(double scale, SyntheticRig* rig) {
   for (Rigid3d& pose : rig->true_map_cam_from_world) {
     pose.translation *= scale;
   }
+}
+
+// The preset's definition with the options' variants (ring size, stereo
+// copies).
+PresetDefinition DefinitionOf(const SyntheticRigOptions& options) {
+  PresetDefinition definition =
+      MakePresetDefinition(options.preset, options.ring_num_cameras);
+  if (options.stereo_num_pairs > 1 || options.stereo_alternate_facing) {
+    ReplicateStereoPair(options.stereo_num_pairs,
+                        options.stereo_alternate_facing, &definition);
+  }
+  return definition;
+}
+
+// The time-model part of SyntheticRigOptions::Check, for options whose other
+// values are valid (the preset's cameras are known).
+bool CheckTimeModel(const SyntheticRigOptions& options,
+                    std::ostringstream* message) {
+  const SyntheticRigOptions defaults;
+  const double rate = options.frameset_rate_hz;
+  if (!(rate >= 0 && std::isfinite(rate))) {
+    *message << "frameset_rate_hz must be >= 0 and finite, got " << rate;
+    return false;
+  }
+  if (!(options.speed_m_s > 0 && std::isfinite(options.speed_m_s)) ||
+      !(options.max_turn_rate_deg_s > 0 &&
+        std::isfinite(options.max_turn_rate_deg_s))) {
+    *message << "speed_m_s and max_turn_rate_deg_s must be positive numbers, "
+                "got "
+             << options.speed_m_s << ", " << options.max_turn_rate_deg_s;
+    return false;
+  }
+  if (!(options.max_time_offset_s >= 0 &&
+        std::isfinite(options.max_time_offset_s))) {
+    *message << "max_time_offset_s must be >= 0 and finite, got "
+             << options.max_time_offset_s;
+    return false;
+  }
+  if (!(options.min_line_delay_s >= 0 &&
+        options.max_line_delay_s >= options.min_line_delay_s &&
+        std::isfinite(options.max_line_delay_s))) {
+    *message << "need 0 <= min_line_delay_s <= max_line_delay_s (finite), got "
+             << options.min_line_delay_s << ", " << options.max_line_delay_s;
+    return false;
+  }
+  if (rate == 0 && (options.speed_m_s != defaults.speed_m_s ||
+                    options.max_turn_rate_deg_s !=
+                        defaults.max_turn_rate_deg_s ||
+                    options.max_time_offset_s > 0 ||
+                    !options.time_offsets_s.empty() ||
+                    options.max_line_delay_s > 0 ||
+                    !options.line_delays_s.empty())) {
+    *message << "speed_m_s, max_turn_rate_deg_s, time offsets and line "
+                "delays need the time model, frameset_rate_hz > 0";
+    return false;
+  }
+  const std::vector<CameraSpec> cameras = DefinitionOf(options).cameras;
+  const size_t num_cameras = cameras.size();
+  if (!options.time_offsets_s.empty()) {
+    if (options.max_time_offset_s > 0 ||
+        options.time_offsets_s.size() != num_cameras ||
+        options.time_offsets_s[0] != 0 ||
+        !std::all_of(options.time_offsets_s.begin(),
+                     options.time_offsets_s.end(),
+                     [](double offset) { return std::isfinite(offset); })) {
+      *message << "time_offsets_s needs one finite offset per camera ("
+               << num_cameras << "), the reference camera's 0, and no "
+               << "max_time_offset_s; got " << options.time_offsets_s.size()
+               << " offsets";
+      return false;
+    }
+  }
+  if (!options.line_delays_s.empty()) {
+    if (options.max_line_delay_s > 0 ||
+        options.line_delays_s.size() != num_cameras ||
+        !std::all_of(options.line_delays_s.begin(),
+                     options.line_delays_s.end(), [](double delay) {
+                       return delay >= 0 && std::isfinite(delay);
+                     })) {
+      *message << "line_delays_s needs one finite delay >= 0 per camera ("
+               << num_cameras << ") and no min/max_line_delay_s; got "
+               << options.line_delays_s.size() << " delays";
+      return false;
+    }
+  }
+  // A camera reads its whole image out within one frameset period.
+  for (size_t c = 0; c < num_cameras && rate > 0; ++c) {
+    const double line_delay = options.line_delays_s.empty()
+                                  ? options.max_line_delay_s
+                                  : options.line_delays_s[c];
+    if (line_delay * cameras[c].height > 1 / rate) {
+      *message << "the readout of camera cam" << c << " (line delay "
+               << line_delay << " s x " << cameras[c].height
+               << " rows) is longer than the frameset period " << 1 / rate
+               << " s (frameset_rate_hz " << rate << ")";
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -236,7 +382,7 @@ bool SyntheticRigOptions::Check(std::string* error) const {
             << map_point_noise << ", " << map_pose_noise_deg << ", "
             << map_pose_noise << ", " << map_drift_deg << ", "
             << map_scale_drift;
-  } else {
+  } else if (CheckTimeModel(*this, &message)) {
     return true;
   }
   *error = message.str();
@@ -252,32 +398,33 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options) {
   }
   // One random stream, drawn in this order: trajectory phases, missing
   // images, then per image (frameset-major) its window, points, wrong
-  // matches, order and noise.
+  // matches, order and noise (the time offsets and line delays have their
+  // own, AddTimeModel).
   std::mt19937 rng(options.seed);
-  PresetDefinition definition =
-      MakePresetDefinition(options.preset, options.ring_num_cameras);
-  if (options.stereo_num_pairs > 1 || options.stereo_alternate_facing) {
-    ReplicateStereoPair(options.stereo_num_pairs,
-                        options.stereo_alternate_facing, &definition);
-  }
+  const PresetDefinition definition = DefinitionOf(options);
   rig.truth = TruthOfDefinition(definition);
   const int num_cameras = rig.truth.cameras.size();
 
   const Rigid3d body_from_rig = BodyFromCamera(definition.cameras[0]);
-  std::vector<Rigid3d> trajectory =
-      MakeTrajectory(definition.motion, options.num_framesets, &rng);
-  for (Rigid3d& world_from_body : trajectory) {
-    if (options.rotation_only) {
-      world_from_body.translation = trajectory.front().translation;
+  if (options.frameset_rate_hz > 0) {
+    AddTimeModel(options, definition.motion, body_from_rig, &rng, &rig.truth);
+  } else {
+    std::vector<Rigid3d> trajectory =
+        MakeTrajectory(definition.motion, options.num_framesets, &rng);
+    for (Rigid3d& world_from_body : trajectory) {
+      if (options.rotation_only) {
+        world_from_body.translation = trajectory.front().translation;
+      }
+      rig.truth.rig_from_world.push_back(
+          (world_from_body * body_from_rig).Inverse());
     }
-    rig.truth.rig_from_world.push_back(
-        (world_from_body * body_from_rig).Inverse());
   }
 
   rig.dataset.cameras = InitialCameras(rig.truth);
   for (int j = 0; j < options.num_framesets; ++j) {
     rig.dataset.frameset_names.push_back(FramesetName(j));
   }
+  rig.dataset.frameset_times_s = rig.truth.frameset_times_s;
   rig.dataset.reference_camera = 0;
 
   const std::vector<std::vector<char>> image_exists = ChooseExistingImages(
@@ -320,6 +467,7 @@ SyntheticRig SelectFramesets(const SyntheticRig& rig,
   selected.dataset.reference_camera = rig.dataset.reference_camera;
   selected.truth = rig.truth;
   selected.truth.rig_from_world.clear();
+  selected.truth.frameset_times_s.clear();
   const int num_framesets = rig.dataset.frameset_names.size();
   std::vector<int> new_index(num_framesets, -1);
   for (const int frameset : framesets) {
@@ -333,6 +481,24 @@ SyntheticRig SelectFramesets(const SyntheticRig& rig,
     selected.dataset.frameset_names.push_back(
         rig.dataset.frameset_names[frameset]);
     selected.truth.rig_from_world.push_back(rig.truth.rig_from_world[frameset]);
+    if (!rig.truth.frameset_times_s.empty()) {
+      selected.truth.frameset_times_s.push_back(
+          rig.truth.frameset_times_s[frameset]);
+    }
+    if (!rig.dataset.frameset_times_s.empty()) {
+      selected.dataset.frameset_times_s.push_back(
+          rig.dataset.frameset_times_s[frameset]);
+    }
+  }
+  // A dataset's frameset times increase (ValidateDataset): a selection out
+  // of time order has none (the truth keeps them).
+  const std::vector<double>& times = selected.dataset.frameset_times_s;
+  if (std::adjacent_find(times.begin(), times.end(), [](double a, double b) {
+        return !(b > a);
+      }) != times.end()) {
+    LOG(WARNING) << "The selected framesets are not in time order: the "
+                    "dataset gets no frameset times";
+    selected.dataset.frameset_times_s.clear();
   }
   // Images in the order of the selected framesets, cameras in order within.
   std::vector<std::vector<int>> images_of_frameset(

@@ -4,6 +4,10 @@
 // projecting map points with COLMAP's camera models, with Gaussian pixel
 // noise, wrong matches (outliers) and missing images.
 //
+// With a time model (frameset_rate_hz > 0) the rig moves continuously
+// (rig_trajectory.h) and every image is taken at its own time, each row of a
+// rolling-shutter camera at its own (capture_model.h).
+//
 // Frames: the world is z-up. Each preset places its cameras in a "body" frame
 // (x forward, y left, z up; for the car, the origin is on the ground below the
 // car's center); the rig frame is camera 0's frame (cam_from_rig[0] is the
@@ -12,11 +16,13 @@
 
 #include <colmap/base/camera.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "src/geometry/rigid3d.h"
 #include "src/rig/rig_dataset.h"
+#include "src/synthetic/rig_trajectory.h"
 
 namespace rig_calibrator {
 
@@ -32,6 +38,20 @@ struct RigGroundTruth {
   std::vector<Rigid3d> cam_from_rig;      // camera 0 (the reference) = identity
   std::vector<Rigid3d> rig_from_world;    // per frameset
   std::vector<std::string> camera_names;  // "cam0", ...
+  // With a time model (SyntheticRigOptions::frameset_rate_hz > 0; else all
+  // empty): per frameset its nominal time t_f = f / frameset_rate_hz
+  // (seconds; rig_from_world[f] is the rig pose at t_f), per camera its
+  // capture-time offset delta_c (seconds, camera 0's is 0) and line delay
+  // rho_c (seconds per row, 0: global shutter): camera c captures the row
+  // through pixel y at t_f + delta_c + rho_c (y - 0.5) (capture_model.h).
+  std::vector<double> frameset_times_s;
+  std::vector<double> time_offsets_s;
+  std::vector<double> line_delays_s;
+  // With a time model: the rig's motion, world_from_body(t), and the rig
+  // frame in the body frame, so that rig_from_world(t) = (world_from_body(t)
+  // * body_from_rig)^-1 (RigFromWorldAtTime in capture_model.h).
+  std::optional<RigTrajectory> trajectory;
+  Rigid3d body_from_rig;
 };
 
 // The true cameras and extrinsics of a preset (rig_from_world is empty):
@@ -124,9 +144,38 @@ struct SyntheticRigOptions {
   // cam_from_rig) is multiplied by it, pixels are unchanged. E.g. 1000 for a
   // map in millimetres; the calibration must be the same up to this scale.
   double map_scale = 1.0;
+  // The time model. 0 (the default): every frameset is taken at one
+  // instant by global-shutter cameras, the rig moving frameset by frameset
+  // along the preset's profile (the data of earlier versions, unchanged for
+  // every seed). > 0: the rig moves continuously (rig_trajectory.h) and
+  // frameset f is taken at t_f = f / frameset_rate_hz seconds, each camera
+  // at its own offset and each row of a rolling shutter at its own time
+  // (capture_model.h); the truth and the dataset carry the times.
+  double frameset_rate_hz = 0;
+  // With frameset_rate_hz > 0: the rig's ground speed (map units per second
+  // before map_scale, i.e. metres) and the peak rate of its heading
+  // (degrees per second); the profile's pitch and roll oscillations are
+  // played at the same pace.
+  double speed_m_s = 1.5;
+  double max_turn_rate_deg_s = 60;
+  // With frameset_rate_hz > 0: the capture-time offset delta_c of every
+  // camera but the reference camera 0 (whose offset is 0), drawn uniformly
+  // in [-max_time_offset_s, max_time_offset_s] (seconds); or, when
+  // time_offsets_s is not empty, given: one per camera, the first 0.
+  double max_time_offset_s = 0;
+  std::vector<double> time_offsets_s;
+  // With frameset_rate_hz > 0: the line delay rho_c of every camera, drawn
+  // uniformly in [min_line_delay_s, max_line_delay_s] (seconds per row; 0:
+  // global shutter); or, when line_delays_s is not empty, given: one per
+  // camera. A camera's readout (line delay times its rows) must fit in the
+  // frameset period 1 / frameset_rate_hz.
+  double min_line_delay_s = 0, max_line_delay_s = 0;
+  std::vector<double> line_delays_s;
   unsigned int seed = 0;
 
-  // False (with a message) for values outside their ranges.
+  // False (with a message naming the option) for values outside their
+  // ranges, and for time offsets, line delays, a speed or a turn rate other
+  // than the defaults without frameset_rate_hz > 0.
   bool Check(std::string* error) const;
 };
 
@@ -134,7 +183,8 @@ struct SyntheticRig {
   // Cameras: same model and size as the truth, parameters = initial guesses
   // (COLMAP's defaults: focal 1.2 * max(width, height), principal point at the
   // image center, zero distortion); names cam0, cam1, ...; images
-  // "camK/000012.png"; frameset names "000012".
+  // "camK/000012.png"; frameset names "000012"; with a time model the
+  // frameset times (the truth's).
   RigDataset dataset;
   RigGroundTruth truth;
   // Per dataset image, per correspondence: 1 for a wrong match.
@@ -157,9 +207,10 @@ SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options);
 void KeepCorrespondencesWithMapTracks(SyntheticRig* rig);
 
 // The sub-problem made of the given framesets (indices into rig, in the given
-// order, renumbered from 0; names kept), e.g. for the short-sequence
+// order, renumbered from 0; names and times kept), e.g. for the short-sequence
 // robustness experiments (paper section 5.3: 10 framesets). Indices out of
-// range or repeated are logged and skipped.
+// range or repeated are logged and skipped. The dataset's frameset times are
+// dropped (with a warning) when the order is not increasing in time.
 SyntheticRig SelectFramesets(const SyntheticRig& rig,
                              const std::vector<int>& framesets);
 

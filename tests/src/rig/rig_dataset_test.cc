@@ -1,6 +1,7 @@
 // ValidateCalibration: a calibration shaped like its dataset, with finite
 // poses and inlier masks of the right length; every other shape fails with a
-// message naming what is wrong.
+// message naming what is wrong. ValidateDataset: frameset times empty or one
+// finite, strictly increasing time per frameset.
 #include "src/rig/rig_dataset.h"
 
 #include <gtest/gtest.h>
@@ -111,6 +112,32 @@ TEST_F(ValidateCalibrationTest, RejectsInlierMasksOfTheWrongLength) {
               "the image cam1/f0.png has 4 inlier flags for 3 correspondences");
   ExpectFails([](RigCalibration* c) { c->images[2].inlier_mask = {1}; },
               "the image cam0/f1.png has 1 inlier flags for 3");
+}
+
+// Frameset times are optional; when given, one finite time per frameset,
+// strictly increasing; the error names the count or the frameset.
+TEST_F(ValidateCalibrationTest, FramesetTimesAreEmptyOrOnePerFramesetIncreasing) {
+  std::string error;
+  EXPECT_TRUE(ValidateDataset(dataset_, &error)) << error;
+  dataset_.frameset_times_s = {0.0, 0.2};
+  EXPECT_TRUE(ValidateDataset(dataset_, &error)) << error;
+  const auto expect_fails = [&](const std::vector<double>& times,
+                                const std::string& expected) {
+    RigDataset dataset = dataset_;
+    dataset.frameset_times_s = times;
+    std::string message;
+    EXPECT_FALSE(ValidateDataset(dataset, &message));
+    EXPECT_NE(message.find(expected), std::string::npos)
+        << "expected '" << expected << "' in: " << message;
+  };
+  expect_fails({0.0}, "the dataset has 1 frameset times for 2 framesets");
+  expect_fails({0.0, 0.2, 0.4}, "3 frameset times for 2 framesets");
+  expect_fails({0.2, 0.2}, "the time of frameset f1 is not finite or not after");
+  expect_fails({0.2, 0.1}, "the time of frameset f1");
+  expect_fails({std::numeric_limits<double>::quiet_NaN(), 0.2},
+               "the time of frameset f0 is not finite");
+  expect_fails({0.0, std::numeric_limits<double>::infinity()},
+               "the time of frameset f1");
 }
 
 }  // namespace rig_dataset_test

@@ -2,9 +2,10 @@
 // bytes of every number and name) of a set of synthetic rigs and rendered
 // dataset plans that together draw every random stream of the generators
 // (each preset, partial feature windows, ground points, tracks, outliers,
-// missing images, enlarged rings), compared with the value recorded when the
-// generators were last changed on purpose. Refactorings must keep it; a
-// deliberate change of the generated data updates it and says so.
+// missing images, enlarged rings; the time model separately), compared with
+// the value recorded when the generators were last changed on purpose.
+// Refactorings must keep it; a deliberate change of the generated data
+// updates it and says so.
 //
 // std::normal_distribution and std::shuffle are implementation-defined, so the
 // recorded values hold for libstdc++ only; elsewhere the test only checks that
@@ -56,6 +57,15 @@ class Fingerprint {
     for (const Rigid3d& pose : truth.cam_from_rig) Add(pose);
     for (const Rigid3d& pose : truth.rig_from_world) Add(pose);
     for (const std::string& name : truth.camera_names) Add(name);
+    // The time model's (empty without it: the earlier values hold).
+    for (const double time : truth.frameset_times_s) Add(time);
+    for (const double offset : truth.time_offsets_s) Add(offset);
+    for (const double delay : truth.line_delays_s) Add(delay);
+    if (truth.trajectory) {
+      for (const double time : {-0.05, 0.0, 0.37, 2.0}) {
+        Add(truth.trajectory->WorldFromBody(time));
+      }
+    }
   }
   void Add(const SyntheticRig& rig) {
     Add(rig.truth);
@@ -122,6 +132,35 @@ uint64_t SyntheticFingerprint() {
   return fingerprint.value();
 }
 
+// The time model: continuous trajectories, drawn and given offsets, rolling
+// shutters (their fixed points), rotation only.
+uint64_t TimeModelFingerprint() {
+  Fingerprint fingerprint;
+  SyntheticRigOptions ring = Case(RigPreset::kRing5, 6, 50, 21);
+  ring.frameset_rate_hz = 5;
+  ring.max_time_offset_s = 0.05;
+  ring.min_line_delay_s = 20e-6;
+  ring.max_line_delay_s = 30e-6;
+  SyntheticRigOptions car = Case(RigPreset::kCarSurround4, 5, 40, 4);
+  car.frameset_rate_hz = 10;
+  car.speed_m_s = 4;
+  car.max_turn_rate_deg_s = 30;
+  car.time_offsets_s = {0, 0.012, -0.03, 0.045};
+  car.line_delays_s = {25e-6, 0, 30e-6, 20e-6};
+  SyntheticRigOptions helmet = Case(RigPreset::kFisheyeHelmet5, 4, 40, 2);
+  helmet.frameset_rate_hz = 20;
+  helmet.max_line_delay_s = 20e-6;
+  helmet.rotation_only = true;
+  for (const SyntheticRigOptions& options : {ring, car, helmet}) {
+    const SyntheticRig rig = GenerateSyntheticRig(options);
+    fingerprint.Add(rig);
+    for (const double time : rig.dataset.frameset_times_s) {
+      fingerprint.Add(time);
+    }
+  }
+  return fingerprint.value();
+}
+
 uint64_t RenderedPlanFingerprint() {
   Fingerprint fingerprint;
   for (const SceneType scene : AllSceneTypes()) {
@@ -155,6 +194,18 @@ TEST(DatasetFingerprint, SameSeedGivesTheRecordedDatasets) {
 #ifdef __GLIBCXX__
   EXPECT_EQ(synthetic, 0x743dc55262ad7d7full);
   EXPECT_EQ(rendered, 0x126c6d298b11d9c9ull);
+#endif
+}
+
+// The time model's data, recorded when it was made (as above: a deliberate
+// change updates the value and says so).
+TEST(DatasetFingerprint, TimeModelGivesTheRecordedDatasets) {
+  const uint64_t time_model = TimeModelFingerprint();
+  std::printf("time model %016llx\n",
+              static_cast<unsigned long long>(time_model));
+  EXPECT_EQ(TimeModelFingerprint(), time_model);
+#ifdef __GLIBCXX__
+  EXPECT_EQ(time_model, 0x698747f29c3da737ull);
 #endif
 }
 
