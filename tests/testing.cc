@@ -1,6 +1,8 @@
 #include "tests/testing.h"
 
+#include <Eigen/Geometry>
 #include <boost/filesystem.hpp>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
@@ -64,6 +66,21 @@ std::set<std::string> ListFolder(const std::string& path) {
 
 std::string SourceDir() { return RIG_CALIBRATOR_SOURCE_DIR; }
 std::string BinaryDir() { return RIG_CALIBRATOR_BINARY_DIR; }
+
+Rigid3d SmoothWalkWorldFromBody(double t) {
+  const double yaw = 0.3 * t + 0.35 * std::sin(2 * M_PI * 0.35 * t + 0.3);
+  const double pitch = 0.15 * std::sin(2 * M_PI * 0.23 * t + 1.0);
+  const double roll = 0.1 * std::sin(2 * M_PI * 0.41 * t);
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  return Rigid3d(rotation,
+                 Eigen::Vector3d(1.3 * t,
+                                 1.5 * std::sin(0.5 * t) + 0.2 * std::sin(2.1 * t),
+                                 1.6 + 0.1 * std::sin(1.7 * t)));
+}
 
 }  // namespace testing
 }  // namespace rig_calibrator

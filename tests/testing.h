@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "src/geometry/rigid3d.h"
+
 namespace rig_calibrator {
 namespace testing {
 
@@ -42,6 +44,13 @@ std::set<std::string> ListFolder(const std::string& path);
 // (path -> "/"): two snapshots are equal iff nothing was added, removed or
 // changed.
 std::map<std::string, std::string> SnapshotFolder(const std::string& folder);
+
+// world_from_body of a rig carried on a smooth walk at about 1.5 m/s (time t
+// in seconds): yaw drifting at 0.3 rad/s plus a 0.35 Hz sway (peak turn rate
+// about 65 deg/s, angular acceleration up to about 1.7 rad/s^2), pitch and
+// roll nods, the body 1.6 m up. The time-offset and interpolation tests'
+// trajectory.
+Rigid3d SmoothWalkWorldFromBody(double t);
 
 // The repository's root and the build tree, as configured by CMake.
 std::string SourceDir();

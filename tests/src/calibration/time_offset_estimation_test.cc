@@ -10,28 +10,12 @@
 #include <random>
 
 #include "src/geometry/pose_interpolation.h"
+#include "tests/testing.h"
 
 namespace rig_calibrator {
 namespace time_offset_estimation_test {
 
 constexpr double kDegToRad = M_PI / 180.0;
-
-// A rig carried on a walk at about 1.5 m/s, turning at up to about 61 deg/s
-// (yaw drift plus a 0.35 Hz sway) with pitch and roll nods.
-Rigid3d SmoothWorldFromRig(double t) {
-  const double yaw = 0.3 * t + 0.35 * std::sin(2 * M_PI * 0.35 * t + 0.3);
-  const double pitch = 0.15 * std::sin(2 * M_PI * 0.23 * t + 1.0);
-  const double roll = 0.1 * std::sin(2 * M_PI * 0.41 * t);
-  const Eigen::Matrix3d rotation =
-      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
-  return Rigid3d(rotation,
-                 Eigen::Vector3d(1.3 * t,
-                                 1.5 * std::sin(0.5 * t) + 0.2 * std::sin(2.1 * t),
-                                 1.6 + 0.1 * std::sin(1.7 * t)));
-}
 
 // Four cameras looking forward, left, back and right (cam_from_rig).
 std::vector<Rigid3d> RingCamFromRig() {
@@ -53,7 +37,7 @@ std::vector<Rigid3d> RingCamFromRig() {
 }
 
 struct Scenario {
-  std::function<Rigid3d(double)> world_from_rig = SmoothWorldFromRig;
+  std::function<Rigid3d(double)> world_from_rig = testing::SmoothWalkWorldFromBody;
   int num_framesets = 100;
   double frame_interval = 0.2;  // 5 Hz
   std::vector<double> offsets = {0.0, 0.037, -0.048, 0.021};

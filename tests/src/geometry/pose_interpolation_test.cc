@@ -6,28 +6,12 @@
 #include <cmath>
 #include <limits>
 
+#include "tests/testing.h"
+
 namespace rig_calibrator {
 namespace pose_interpolation_test {
 
 constexpr double kDegPerRad = 180.0 / M_PI;
-
-// A smooth walk with a turning rig: yaw drifting at 0.3 rad/s plus a 0.35 Hz
-// sway (peak rate 65 deg/s, angular acceleration up to ~1.7 rad/s^2),
-// pitch and roll nods, position at about 1.5 m/s.
-Rigid3d SmoothWorldFromBody(double t) {
-  const double yaw = 0.3 * t + 0.35 * std::sin(2 * M_PI * 0.35 * t + 0.3);
-  const double pitch = 0.15 * std::sin(2 * M_PI * 0.23 * t + 1.0);
-  const double roll = 0.1 * std::sin(2 * M_PI * 0.41 * t);
-  const Eigen::Matrix3d rotation =
-      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
-  const Eigen::Vector3d position(
-      1.3 * t, 1.5 * std::sin(0.5 * t) + 0.2 * std::sin(2.1 * t),
-      0.1 * std::sin(1.7 * t));
-  return Rigid3d(rotation, position);
-}
 
 double RotationErrorRad(const Rigid3d& a, const Rigid3d& b) {
   return RotationDifferenceRad(a.rotation, b.rotation);
@@ -126,7 +110,9 @@ TEST(PoseTrajectory, ExactOnItsOwnClassConstantAngularVelocity) {
 // across knots (C1) and outside the range (extrapolation).
 TEST(PoseTrajectory, VelocitiesAreTheDerivativesOfThePose) {
   std::vector<Rigid3d> poses;
-  for (double t : IrregularTimes()) poses.push_back(SmoothWorldFromBody(t));
+  for (double t : IrregularTimes()) {
+    poses.push_back(testing::SmoothWalkWorldFromBody(t));
+  }
   const PoseTrajectory trajectory = MakeTrajectory(IrregularTimes(), poses);
   const double h = 1e-6;
   for (double t : {-0.1, 0.0, 0.1, 0.4, 0.57, 1.0, 1.15, 1.9, 2.2, 2.35}) {
@@ -154,13 +140,13 @@ TEST(PoseTrajectory, FiveHertzErrorOnSmoothTrajectoryIsFarBelowSlerp) {
   std::vector<Rigid3d> poses;
   for (int i = 0; i <= 100; ++i) {
     times.push_back(0.2 * i);
-    poses.push_back(SmoothWorldFromBody(times.back()));
+    poses.push_back(testing::SmoothWalkWorldFromBody(times.back()));
   }
   const PoseTrajectory trajectory = MakeTrajectory(times, poses);
   double max_rotation = 0, max_position = 0;
   double max_slerp_rotation = 0, max_linear_position = 0;
   for (double t = 0.0; t <= 20.0; t += 0.01) {
-    const Rigid3d truth = SmoothWorldFromBody(t);
+    const Rigid3d truth = testing::SmoothWalkWorldFromBody(t);
     const Rigid3d interpolated = trajectory.Evaluate(t).world_from_body;
     max_rotation = std::max(max_rotation, RotationErrorRad(interpolated, truth));
     max_position = std::max(
