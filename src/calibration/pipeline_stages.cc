@@ -410,9 +410,10 @@ void RunCaptureTiming(const PipelineOptions& options, const RigDataset& dataset,
           << " deg/s). The calibration assumes that every frameset was "
              "taken at one instant: the cam_from_rig and intrinsics of "
           << CameraList(dataset, cameras)
-          << " are biased by the rig's motion during the offset. Synchronize "
-             "the cameras, or calibrate from framesets taken while the rig "
-             "stands still.";
+          << " are biased by the rig's motion during the offset (and the "
+             "offsets, measured with those intrinsics, are lower bounds). "
+             "Synchronize the cameras, or calibrate from framesets taken "
+             "while the rig stands still.";
   AddDiagnostic(report, Diagnostic::Level::kWarning, "unsynchronized_cameras",
                 message.str(), cameras);
 }
