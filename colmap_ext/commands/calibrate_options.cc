@@ -58,6 +58,11 @@ void AddRigCalibratorOptions(po::options_description* description,
             "0: a frameset is the images with the same file name; > 0: "
             "numeric names (e.g. nanosecond timestamps) within this "
             "tolerance");
+  AddOption(description, "RigCalibrator.timestamp_unit_s",
+            &o->timestamp_unit_s,
+            "seconds per unit of the numeric names (1e-9: nanoseconds); "
+            "with timestamp_tolerance > 0 they give the frameset times of "
+            "the capture-time offsets");
   AddUnsetOption(description, "RigCalibrator.intrinsics_path",
                  &o->intrinsics_path,
                  "known intrinsics for the known* methods (rig_config.json "

@@ -27,6 +27,9 @@ struct CalibrateOptions {
   std::string reference_camera;
   std::string camera_prefixes;
   double timestamp_tolerance = 0;
+  // Seconds per unit of the numeric names (the frameset times of the
+  // capture-time offsets, capture_timing.h).
+  double timestamp_unit_s = 1e-9;
   std::string intrinsics_path;
   // COLMAP's refinement switches, "1"/"0" or per camera "cam0:0,cam1:1"
   // (intrinsics_refinement_input.h).

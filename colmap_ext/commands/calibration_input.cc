@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <boost/algorithm/string.hpp>
+#include <cmath>
 #include <boost/filesystem.hpp>
 #include <iomanip>
 #include <iostream>
@@ -126,6 +127,11 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
                  const RigLayoutOptions& frames = RigLayoutOptions()) {
   RigLayoutOptions layout_options = frames;
   layout_options.timestamp_tolerance = options.timestamp_tolerance;
+  if (!(options.timestamp_unit_s > 0) ||
+      !std::isfinite(options.timestamp_unit_s)) {
+    *error = "--RigCalibrator.timestamp_unit_s must be a finite number > 0";
+    return false;
+  }
   if (!options.camera_prefixes.empty()) {
     boost::split(layout_options.camera_prefixes, options.camera_prefixes,
                  boost::is_any_of(","));
@@ -195,6 +201,8 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
     image.frameset_index = layout->images[i].frameset_index;
     dataset->images.push_back(image);
   }
+  dataset->frameset_times_s = FramesetTimes(*layout, dataset->reference_camera,
+                                            options.timestamp_unit_s);
   return true;
 }
 

@@ -40,6 +40,7 @@ CalibrationSummary MakeCalibrationSummary(
   summary.method = CalibrationMethodName(report.used_method);
   summary.seed = seed;
   summary.uncertainty = report.uncertainty;
+  summary.capture_timing = report.capture_timing;
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);
@@ -83,6 +84,13 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
     std::cout << "  " << line << "\n";
   }
   PrintCoverage(summary);
+  if (report.capture_timing.computed) {
+    std::cout << "  "
+              << CaptureTimingLine(CameraNames(summary),
+                                   dataset.reference_camera,
+                                   report.capture_timing)
+              << "\n";
+  }
   if (!summary.known_rig_source.empty()) {
     std::cout << "  against the known rig of " << summary.known_rig_source
               << " (cam_from_" << summary.known_rig_reference_camera << "):\n";

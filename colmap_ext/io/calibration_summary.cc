@@ -65,6 +65,35 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// {"reference_camera", "num_image_poses", "rig_angular_speed_deg_s",
+// "error" (null, or why the offsets were not measured), "cameras": [{"name",
+// "offset_s", "offset_sigma_s" (null when infinite), "observable",
+// "significant", "num_framesets_used", "diagnosis"}]}.
+Json CaptureTimingJson(const CalibrationSummary& summary) {
+  const CaptureTiming& timing = summary.capture_timing;
+  Json node;
+  node["reference_camera"] = summary.reference_camera;
+  node["num_image_poses"] = timing.num_image_poses;
+  node["rig_angular_speed_deg_s"] =
+      JsonNumber(timing.rig_angular_speed_rad_s * 180.0 / M_PI);
+  node["error"] = timing.error.empty() ? Json(nullptr) : Json(timing.error);
+  node["cameras"] = Json::array();
+  for (size_t c = 0; c < timing.offsets.size(); ++c) {
+    const CameraTimeOffset& offset = timing.offsets[c];
+    node["cameras"].push_back(
+        {{"name", summary.cameras[c].name},
+         {"offset_s", JsonNumber(offset.offset_s)},
+         {"offset_sigma_s", std::isfinite(offset.offset_sigma_s)
+                                ? JsonNumber(offset.offset_sigma_s)
+                                : Json(nullptr)},
+         {"observable", offset.observable},
+         {"significant", static_cast<bool>(timing.significant[c])},
+         {"num_framesets_used", offset.num_framesets_used},
+         {"diagnosis", offset.diagnosis}});
+  }
+  return node;
+}
+
 bool WriteJson(const std::string& path, const Json& root, std::string* error) {
   return WriteFileAtomically(
       path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
@@ -153,6 +182,9 @@ bool WriteCalibrationSummaryJson(const std::string& path,
   }
   root["cameras"] = cameras;
   AddUncertaintyJson(summary.uncertainty, &root);
+  if (summary.capture_timing.computed) {
+    root["capture_time_offsets"] = CaptureTimingJson(summary);
+  }
   if (summary.known_rig_source.empty()) {
     root["known_rig"] = nullptr;
   } else {

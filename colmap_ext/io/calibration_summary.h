@@ -16,6 +16,7 @@
 
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
 #include "src/geometry/rigid3d.h"
@@ -98,6 +99,9 @@ struct CalibrationSummary {
   std::vector<StageTiming> timings;
   std::optional<MapImagesSummary> map_images;  // with a map
   CalibrationUncertainty uncertainty;          // of the pipeline's report
+  // The capture-time offsets (PipelineReport::capture_timing); written as
+  // "capture_time_offsets" only when computed.
+  CaptureTiming capture_timing;
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

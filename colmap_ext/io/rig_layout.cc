@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <unordered_set>
 
@@ -331,11 +333,12 @@ bool GroupGivenFrames(const std::vector<std::string>& image_names,
 
 // The framesets, each a list of input indices: the images with the same key,
 // or (timestamp_tolerance > 0) the clusters of close timestamps per folder.
+// With timestamps, also each image's time (RigLayout::image_times).
 bool GroupFramesets(const std::vector<std::string>& image_names,
                     const std::vector<std::string>& keys,
                     const RigLayoutOptions& options, const RigLayout& layout,
                     std::vector<std::vector<int>>* framesets,
-                    std::string* error) {
+                    std::vector<double>* image_times, std::string* error) {
   if (!options.frame_ids.empty()) {
     return GroupGivenFrames(image_names, keys, options, layout, framesets,
                             error);
@@ -353,6 +356,20 @@ bool GroupFramesets(const std::vector<std::string>& image_names,
         return false;
       }
       folder_images[timed_keys[i].folder].push_back(static_cast<int>(i));
+    }
+    // Relative to the earliest name, so that the differences of 19-digit
+    // nanosecond stamps keep their precision as doubles.
+    long double earliest = std::numeric_limits<long double>::infinity();
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index >= 0) {
+        earliest = std::min(earliest, timed_keys[i].time);
+      }
+    }
+    image_times->assign(image_names.size(), -1.0);
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index >= 0) {
+        (*image_times)[i] = static_cast<double>(timed_keys[i].time - earliest);
+      }
     }
     std::vector<std::string> folders;
     for (const auto& entry : folder_images) folders.push_back(entry.first);
@@ -450,6 +467,41 @@ bool NaturalLess(const std::string& a, const std::string& b) {
   return a < b;
 }
 
+std::vector<double> FramesetTimes(const RigLayout& layout,
+                                  const int reference_camera,
+                                  const double unit_s) {
+  if (layout.image_times.size() != layout.images.size() || !(unit_s > 0)) {
+    return {};
+  }
+  std::vector<std::vector<double>> frameset_image_times(
+      layout.frameset_names.size());
+  std::vector<std::optional<double>> reference_times(
+      layout.frameset_names.size());
+  for (size_t i = 0; i < layout.images.size(); ++i) {
+    const RigLayoutImage& image = layout.images[i];
+    if (image.camera_index < 0 || image.frameset_index < 0) continue;
+    frameset_image_times[image.frameset_index].push_back(
+        layout.image_times[i]);
+    if (image.camera_index == reference_camera) {
+      reference_times[image.frameset_index] = layout.image_times[i];
+    }
+  }
+  std::vector<double> times;
+  for (size_t f = 0; f < frameset_image_times.size(); ++f) {
+    std::vector<double>& image_times = frameset_image_times[f];
+    if (image_times.empty()) return {};
+    std::sort(image_times.begin(), image_times.end());
+    const size_t n = image_times.size();
+    const double median = (image_times[(n - 1) / 2] + image_times[n / 2]) / 2;
+    times.push_back(reference_times[f].value_or(median) * unit_s);
+    // Names beyond long double's range parse as infinite.
+    if (!std::isfinite(times[f]) || (f > 0 && !(times[f] > times[f - 1]))) {
+      return {};
+    }
+  }
+  return times;
+}
+
 bool DiscoverRigLayout(const std::vector<std::string>& image_names,
                        const RigLayoutOptions& options, RigLayout* layout,
                        std::string* error) {
@@ -468,7 +520,8 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
   std::vector<std::vector<int>> framesets;
   if (!CameraPrefixes(image_names, options, &prefixes, error) ||
       !AssignCameras(image_names, prefixes, layout, &keys, error) ||
-      !GroupFramesets(image_names, keys, options, *layout, &framesets, error)) {
+      !GroupFramesets(image_names, keys, options, *layout, &framesets,
+                      &layout->image_times, error)) {
     return false;
   }
   NameFramesets(keys, framesets, layout);

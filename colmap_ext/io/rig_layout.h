@@ -60,6 +60,10 @@ struct RigLayout {
   // Where the framesets come from, for the rig table: "identical names after
   // the camera prefix", "timestamps within ...", or the given frame_source.
   std::string frameset_source;
+  // With timestamp_tolerance > 0 (and no given frames): per input image its
+  // number minus the smallest one (in the names' units; -1 for an ignored
+  // image), else empty.
+  std::vector<double> image_times;
 };
 
 // Discovers the cameras and framesets of `image_names` (the rig images only,
@@ -78,6 +82,16 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
 // framesets with k cameras; the first unmatched and ignored names.
 std::string RigLayoutTable(const std::vector<std::string>& image_names,
                            const RigLayout& layout);
+
+// The frameset times (RigDataset::frameset_times_s) of a layout with
+// image_times: per frameset the time of its `reference_camera` image, or the
+// median of its images' times when that camera is not in it, times
+// `unit_s` (seconds per name unit, e.g. 1e-9 for nanosecond names); origin
+// the earliest image. Empty when the layout has no times or the frameset
+// times are not strictly increasing (e.g. framesets of several subfolders,
+// which are ordered by folder first).
+std::vector<double> FramesetTimes(const RigLayout& layout, int reference_camera,
+                                  double unit_s);
 
 // Natural order: digit runs compare as numbers ("cam2" < "cam10").
 bool NaturalLess(const std::string& a, const std::string& b);

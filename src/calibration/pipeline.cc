@@ -112,6 +112,7 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
   }
   CheckCameraModels(options, dataset, *calibration, report);
   RunUncertaintyEstimation(options, method, dataset, *calibration, report);
+  RunCaptureTiming(options, dataset, *calibration, report);
   SummarizeCalibration(dataset, *calibration, report);
   DiagnoseCoverage(dataset, *calibration, report);
   report->total_seconds = total_timer.ElapsedSeconds();

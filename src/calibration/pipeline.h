@@ -20,6 +20,7 @@
 
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/camera_upgrader.h"
+#include "src/calibration/capture_timing.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
 #include "src/calibration/model_choice_after_adjustment.h"
@@ -51,6 +52,9 @@ struct PipelineOptions {
   // pipeline's: set when it runs).
   ModelChoiceAfterAdjustmentOptions model_choice_after_adjustment;
   FinalBundleAdjustmentOptions final_bundle_adjustment;
+  // The capture-time offsets after the final adjustment, when the dataset
+  // has frameset times (capture_timing.h).
+  CaptureTimingOptions capture_timing;
 
   // Correspondences within this radial error of the refined radial rig are
   // handed to the camera upgrade (pixels).

@@ -13,6 +13,7 @@
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
 #include "src/rig/intrinsics_refinement.h"
@@ -60,6 +61,10 @@ struct PipelineReport {
   // Per camera, the coverage of its image by the final inliers (none for a
   // camera that was not calibrated; coverage_diagnosis.h).
   std::vector<std::optional<ImageCoverage>> coverage;
+  // The capture-time offsets measured after the final adjustment
+  // (capture_timing.h); `computed` false when the dataset has no frameset
+  // times.
+  CaptureTiming capture_timing;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

@@ -3,7 +3,9 @@
 #include <colmap/util/math.h>
 
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <utility>
 
 #include "src/calibration/camera_model_stage.h"
@@ -367,6 +369,53 @@ void RunUncertaintyEstimation(const PipelineOptions& options,
       std::cout << "  not computed: " << uncertainty.message << std::endl;
     }
   }
+}
+
+void RunCaptureTiming(const PipelineOptions& options, const RigDataset& dataset,
+                      const RigCalibration& calibration,
+                      PipelineReport* report) {
+  const int num_calibrated = static_cast<int>(
+      std::count(calibration.camera_calibrated.begin(),
+                 calibration.camera_calibrated.end(), true));
+  if (dataset.frameset_times_s.empty() || num_calibrated < 2) return;
+  StageTimer stage("Capture-time offsets", options.print_progress, report);
+  CaptureTiming& timing = report->capture_timing;
+  timing = MeasureCaptureTiming(dataset, calibration, report->uncertainty,
+                                options.capture_timing);
+  std::vector<std::string> names;
+  for (const RigCamera& camera : dataset.cameras) names.push_back(camera.name);
+  if (options.print_progress) {
+    std::cout << "  "
+              << CaptureTimingLine(names, dataset.reference_camera, timing)
+              << std::endl;
+  }
+  std::vector<int> cameras;
+  std::ostringstream offsets;
+  for (size_t c = 0; c < timing.significant.size(); ++c) {
+    if (!timing.significant[c]) continue;
+    offsets << (cameras.empty() ? "" : ", ") << names[c] << " "
+            << std::showpos << std::fixed << std::setprecision(1)
+            << timing.offsets[c].offset_s * 1e3 << std::noshowpos
+            << " +- " << timing.offsets[c].offset_sigma_s * 1e3 << " ms";
+    cameras.push_back(static_cast<int>(c));
+  }
+  if (cameras.empty()) return;
+  std::ostringstream message;
+  message << "the cameras were not synchronized: " << offsets.str()
+          << " (capture time minus " << names[dataset.reference_camera]
+          << "'s, from each image's own pose and the frameset times; the rig "
+             "turns at "
+          << std::fixed << std::setprecision(1)
+          << timing.rig_angular_speed_rad_s * 180.0 / M_PI
+          << " deg/s). The calibration assumes that every frameset was "
+             "taken at one instant: the cam_from_rig and intrinsics of "
+          << CameraList(dataset, cameras)
+          << " are biased by the rig's motion during the offset (and the "
+             "offsets, measured with those intrinsics, are lower bounds). "
+             "Synchronize the cameras, or calibrate from framesets taken "
+             "while the rig stands still.";
+  AddDiagnostic(report, Diagnostic::Level::kWarning, "unsynchronized_cameras",
+                message.str(), cameras);
 }
 
 }  // namespace rig_calibrator

@@ -56,4 +56,13 @@ void RunUncertaintyEstimation(const PipelineOptions& options,
                               const RigCalibration& calibration,
                               PipelineReport* report);
 
+// With frameset times and at least two calibrated cameras: the capture-time
+// offsets of the cameras (capture_timing.h) into report->capture_timing, and
+// the warning unsynchronized_cameras naming those whose offset is
+// significant. Otherwise nothing (no stage, no output). Never fails the
+// calibration.
+void RunCaptureTiming(const PipelineOptions& options, const RigDataset& dataset,
+                      const RigCalibration& calibration,
+                      PipelineReport* report);
+
 }  // namespace rig_calibrator

@@ -104,5 +104,52 @@ TEST(CompareWithKnownRig, NothingWithoutAPriorOrACalibratedReference) {
   EXPECT_TRUE(nlohmann::json::parse(file)["known_rig"].is_null());
 }
 
+// "capture_time_offsets" only when the offsets were computed: per camera
+// offset, sigma (null when infinite), observable, significant; the same
+// summary without them writes the same bytes as before the field existed
+// (no key at all).
+TEST(CaptureTimeOffsetsJson, WrittenOnlyWhenComputed) {
+  CalibrationSummary summary;
+  summary.reference_camera = "cam0";
+  summary.cameras.resize(2);
+  summary.cameras[0].name = "cam0";
+  summary.cameras[1].name = "cam1";
+  testing::ScopedTempDir temp;
+  const std::string untimed = temp.File("untimed.json");
+  std::string error;
+  ASSERT_TRUE(WriteCalibrationSummaryJson(untimed, summary, &error)) << error;
+  std::ifstream untimed_file(untimed);
+  EXPECT_FALSE(nlohmann::json::parse(untimed_file).contains(
+      "capture_time_offsets"));
+
+  summary.capture_timing.computed = true;
+  summary.capture_timing.num_image_poses = 37;
+  summary.capture_timing.rig_angular_speed_rad_s = M_PI / 6;
+  summary.capture_timing.offsets.resize(2);
+  summary.capture_timing.offsets[0].offset_sigma_s = INFINITY;
+  summary.capture_timing.offsets[1].offset_s = 0.0123;
+  summary.capture_timing.offsets[1].offset_sigma_s = 0.0004;
+  summary.capture_timing.offsets[1].observable = true;
+  summary.capture_timing.offsets[1].num_framesets_used = 18;
+  summary.capture_timing.significant = {false, true};
+  const std::string timed = temp.File("timed.json");
+  ASSERT_TRUE(WriteCalibrationSummaryJson(timed, summary, &error)) << error;
+  std::ifstream timed_file(timed);
+  const nlohmann::json node =
+      nlohmann::json::parse(timed_file)["capture_time_offsets"];
+  EXPECT_EQ(node["reference_camera"], "cam0");
+  EXPECT_EQ(node["num_image_poses"], 37);
+  EXPECT_NEAR(node["rig_angular_speed_deg_s"].get<double>(), 30, 1e-12);
+  EXPECT_TRUE(node["error"].is_null());
+  ASSERT_EQ(node["cameras"].size(), 2u);
+  EXPECT_TRUE(node["cameras"][0]["offset_sigma_s"].is_null());
+  EXPECT_EQ(node["cameras"][1]["name"], "cam1");
+  EXPECT_EQ(node["cameras"][1]["offset_s"].get<double>(), 0.0123);
+  EXPECT_EQ(node["cameras"][1]["offset_sigma_s"].get<double>(), 0.0004);
+  EXPECT_EQ(node["cameras"][1]["observable"], true);
+  EXPECT_EQ(node["cameras"][1]["significant"], true);
+  EXPECT_EQ(node["cameras"][1]["num_framesets_used"], 18);
+}
+
 }  // namespace calibration_summary_test
 }  // namespace rig_calibrator

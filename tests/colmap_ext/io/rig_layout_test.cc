@@ -153,6 +153,69 @@ TEST(RigLayout, NanosecondTimestampsWithinTolerance) {
   EXPECT_NE(error.find("never share a frameset"), std::string::npos) << error;
 }
 
+// The frameset times of the capture-time offsets: the reference camera's
+// stamp, else the median of the frameset's stamps, in seconds from the
+// earliest name (19-digit nanosecond names keep their nanoseconds); none
+// without timestamps, with a unit that is not positive, or when framesets of
+// two subfolders are not in time order.
+TEST(RigLayout, FramesetTimesFromNanosecondNames) {
+  const std::vector<std::string> names = {
+      "cam0/1403715273262142976.png", "cam1/1403715273263142976.png",
+      "cam0/1403715273312142976.png", "cam1/1403715273314142976.png",
+      "cam0/1403715273362142976.png", "cam1/1403715273414142976.png",
+      "cam0/1403715273462142976.png", "cam1/1403715273461142976.png",
+      "cam1/1403715273513142976.png", "cam1/1403715273513142976.jpg"};
+  RigLayoutOptions options;
+  options.timestamp_tolerance = 5e6;
+  RigLayout layout;
+  std::string error;
+  ASSERT_TRUE(DiscoverRigLayout(names, options, &layout, &error)) << error;
+  ASSERT_EQ(layout.frameset_names.size(), 7u);
+  // The last two are cam1 at one time: two framesets of one image each, not
+  // strictly increasing.
+  EXPECT_TRUE(FramesetTimes(layout, 0, 1e-9).empty());
+
+  const std::vector<std::string> increasing(names.begin(), names.end() - 1);
+  ASSERT_TRUE(DiscoverRigLayout(increasing, options, &layout, &error))
+      << error;
+  ASSERT_EQ(layout.frameset_names.size(), 6u);
+  const std::vector<double> cam0_times = FramesetTimes(layout, 0, 1e-9);
+  const std::vector<double> expected0 = {0, 0.050, 0.100, 0.152, 0.200, 0.251};
+  ASSERT_EQ(cam0_times.size(), expected0.size());
+  for (size_t f = 0; f < expected0.size(); ++f) {
+    EXPECT_NEAR(cam0_times[f], expected0[f], 1e-12) << f;
+  }
+  // cam1 as reference: its stamps where present; the frameset of cam0 alone
+  // (0.100) is the median of its one stamp. Two stamps: their mean.
+  const std::vector<double> cam1_times = FramesetTimes(layout, 1, 1e-9);
+  const std::vector<double> expected1 = {0.001, 0.052, 0.100,
+                                         0.152, 0.199, 0.251};
+  ASSERT_EQ(cam1_times.size(), expected1.size());
+  for (size_t f = 0; f < expected1.size(); ++f) {
+    EXPECT_NEAR(cam1_times[f], expected1[f], 1e-12) << f;
+  }
+  // Milliseconds as units.
+  EXPECT_NEAR(FramesetTimes(layout, 0, 1e-3)[1], 50e3, 1e-6);
+  EXPECT_TRUE(FramesetTimes(layout, 0, 0).empty());
+
+  // Names without a tolerance: no times.
+  ASSERT_TRUE(DiscoverRigLayout({"cam0/1.png", "cam1/1.png", "cam0/2.png",
+                                 "cam1/2.png"},
+                                RigLayoutOptions(), &layout, &error))
+      << error;
+  EXPECT_TRUE(layout.image_times.empty());
+  EXPECT_TRUE(FramesetTimes(layout, 0, 1e-9).empty());
+
+  // Two subfolders: framesets ordered by folder, b's earlier than a's.
+  options.timestamp_tolerance = 0.5;
+  ASSERT_TRUE(DiscoverRigLayout({"cam0/a/5.png", "cam1/a/5.png",
+                                 "cam0/b/1.png", "cam1/b/1.png"},
+                                options, &layout, &error))
+      << error;
+  EXPECT_EQ(layout.image_times.size(), 4u);
+  EXPECT_TRUE(FramesetTimes(layout, 0, 1.0).empty());
+}
+
 // Degenerate data (issue 15): timestamps that do not match within the
 // tolerance (cam1's clock 12 ms behind cam0's, the tolerance 5 ms) leave the
 // cameras without a common frameset. The error names the groups, the closest
