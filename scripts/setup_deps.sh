@@ -118,7 +118,9 @@ archive_colmap_commands() {
   done
   objcopy --redefine-sym main=ColmapMain "$work/colmap_colmap.o" \
     || die "objcopy could not rename main in $exe_objects/colmap.cc.o."
-  nm "$work/colmap_colmap.o" | grep -q ' T ColmapMain$' \
+  # (grep without -q reads all of nm's output: with pipefail, nm killed by
+  # SIGPIPE after an early match would fail the check.)
+  nm "$work/colmap_colmap.o" | grep ' T ColmapMain$' > /dev/null \
     || die "no ColmapMain in $work/colmap_colmap.o after renaming main."
   rm -f "$commands_archive.tmp"
   ar rcs "$commands_archive.tmp" "${objects[@]}" && mv "$commands_archive.tmp" "$commands_archive"
@@ -147,8 +149,9 @@ fetch_colmap_source
 # (about 50 s of CPU).
 exe_cmake="$src/src/exe/CMakeLists.txt"
 sed -i '/^COLMAP_ADD_EXECUTABLE(colmap_exe$/,/)$/{/^ *\(feature\|sfm\)\.cc$/d}' "$exe_cmake"
-if sed -n '/^COLMAP_ADD_EXECUTABLE(colmap_exe$/,/)$/p' "$exe_cmake" | grep -q '^ *\(feature\|sfm\)\.cc$' ||
-  ! sed -n '/^COLMAP_ADD_EXECUTABLE(colmap_exe$/,/)$/p' "$exe_cmake" | grep -q '^ *colmap\.cc$'; then
+exe_sources="$(sed -n '/^COLMAP_ADD_EXECUTABLE(colmap_exe$/,/)$/p' "$exe_cmake")"
+if grep -q '^ *\(feature\|sfm\)\.cc$' <<< "$exe_sources" ||
+  ! grep -q '^ *colmap\.cc$' <<< "$exe_sources"; then
   die "unexpected COLMAP_ADD_EXECUTABLE(colmap_exe ...) in $exe_cmake."
 fi
 
