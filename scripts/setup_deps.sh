@@ -140,7 +140,7 @@ if [ -f "$stamp" ] && [ -x "$prefix/bin/colmap" ] && [ -f "$prefix/share/colmap/
   rm -f "$stamp"
 fi
 
-say "building COLMAP 3.8 from Debian's source package into $prefix (about 9 minutes on 2 cores)"
+say "building COLMAP 3.8 from Debian's source package into $prefix (about 7 minutes on 2 cores)"
 fetch_colmap_source
 
 # COLMAP's own `colmap` compiles feature.cc and sfm.cc a second time, though
