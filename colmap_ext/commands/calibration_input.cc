@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <boost/algorithm/string.hpp>
-#include <cmath>
 #include <boost/filesystem.hpp>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <map>

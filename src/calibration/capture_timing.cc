@@ -48,13 +48,13 @@ bool RefineOwnPose(const RigImage& image,
   return true;
 }
 
-// The image's own cam_from_world (see the top of the header), or nothing
-// when it has too few inliers or the refinement fails.
 int CountSet(const std::vector<char>& mask) {
   return static_cast<int>(
       std::count_if(mask.begin(), mask.end(), [](char m) { return m != 0; }));
 }
 
+// The image's own cam_from_world (see the top of the header), or nothing
+// when it has too few inliers or the refinement fails.
 std::optional<Rigid3d> OwnCamFromWorld(const RigDataset& dataset,
                                        const RigCalibration& calibration,
                                        size_t image_index,
