@@ -155,6 +155,15 @@ if grep -q '^ *\(feature\|sfm\)\.cc$' <<< "$exe_sources" ||
   die "unexpected COLMAP_ADD_EXECUTABLE(colmap_exe ...) in $exe_cmake."
 fi
 
+# The Poisson surface reconstruction (`colmap poisson_mesher`, dense meshing,
+# no part of a calibration) is one file that takes 105 s of CPU at -O3 and
+# 28 s at -O1 (g++ 12, COLMAP's flags): it is compiled at -O1 (a later -O
+# wins; the source's options come after the build type's flags).
+poisson_cmake="$src/lib/PoissonRecon/CMakeLists.txt"
+grep -q 'PoissonRecon.cpp PROPERTIES COMPILE_OPTIONS -O1' "$poisson_cmake" ||
+  printf '\nset_source_files_properties(PoissonRecon.cpp PROPERTIES COMPILE_OPTIONS -O1)\n' \
+    >> "$poisson_cmake"
+
 # Ninja compiles the objects of COLMAP's libraries in any order (Make waits for
 # each library before the next one's objects), which keeps both cores busy.
 # A folder left by an unfinished build with another generator starts afresh.
