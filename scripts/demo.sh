@@ -17,7 +17,13 @@
 #   is replaced)
 # Environment:
 #   DEMO_PRESET      rig: ring5 (default), fisheye_helmet5, car_surround4,
-#                    stereo_pair
+#                    stereo_pair, or gopro_helmet5: the fisheye helmet as
+#                    unsynchronized rolling-shutter cameras (GoPro-like):
+#                    framesets at 5 Hz, capture-time offsets drawn in
+#                    +-50 ms, line delays in 20-30 us per row, the rig at
+#                    1.5 m/s turning at up to 60 deg/s; the images are named
+#                    by their capture times and grouped into framesets by
+#                    --RigCalibrator.timestamp_tolerance
 #   DEMO_SCENE       room (default), courtyard, street
 #   DEMO_SEED        0 (default)
 #   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 20)
@@ -61,17 +67,32 @@ source "$repo/scripts/find_colmap.sh"
 [[ -x "$rig_calibrator_lab" ]] ||
   die "no $rig_calibrator_lab: build it (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 
+# gopro_helmet5: fisheye_helmet5 with the time model (the options of
+# `rig_calibrator_lab render`, as `synthetic` takes them).
+time_model=()
+if [[ "$preset" == gopro_helmet5 ]]; then
+  preset=fisheye_helmet5
+  time_model=(--frameset_rate_hz 5 --speed_m_s 1.5 --max_turn_rate_deg_s 60
+              --max_time_offset_ms 50 --line_delay_us 20,30)
+fi
+
 dataset="$out/dataset"
-run_step "render ($preset, $scene)" "$rig_calibrator_lab" render \
+run_step "render ($preset, $scene${time_model:+, time model})" \
+  "$rig_calibrator_lab" render \
   --preset "$preset" --scene "$scene" --seed "$seed" \
   --num_map_images "$num_map_images" --num_framesets "$num_framesets" \
-  --output_path "$dataset"
+  "${time_model[@]}" --output_path "$dataset"
 
 truth="$dataset/ground_truth"
 map_params=$(awk '!/^#/ { print $4 }' "$truth/map_camera.txt")
 true_models=$(awk '$1 == "camera_models" { print $2 }' "$truth/dataset.txt")
 [[ -n "$map_params" && -n "$true_models" ]] || die "incomplete ground truth in $truth"
 [[ "$camera_model" != true ]] || camera_model="$true_models"
+# With a time model the rig images have time stamps for names (ns): the
+# tolerance the renderer gives groups them into framesets.
+grouping=()
+tolerance=$(awk '$1 == "timestamp_tolerance_ns" { print $2 }' "$truth/dataset.txt")
+[[ -z "$tolerance" ]] || grouping=(--RigCalibrator.timestamp_tolerance "$tolerance")
 
 # Fewer features and a short matching window keep the demo fast: neighbours
 # in the rendered sequence share thousands of inlier matches.
@@ -83,7 +104,8 @@ run_step "map (colmap)" env MAP_MAX_FEATURES="${MAP_MAX_FEATURES:-2048}" \
 # DEMO_CAMERA_MODEL says otherwise.
 run_step "calibration (colmap + rig_calibrator)" \
   bash "$repo/scripts/calibrate_rig.sh" "$out/map/database.db" "$out/map/sparse/0" \
-  "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_model"
+  "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_model" \
+  "${grouping[@]}"
 
 run_step "evaluation" "$colmap_extended" rig_calibrator evaluate \
   --reference_path "$truth/rig_config.json" \

@@ -5,6 +5,7 @@
 
 #include <boost/filesystem.hpp>
 #include <boost/program_options.hpp>
+#include <cmath>
 #include <iostream>
 #include <sstream>
 
@@ -13,6 +14,8 @@
 #include "colmap_ext/io/number_text.h"
 #include "colmap_ext/io/rig_config_io.h"
 #include "colmap_ext/io/rig_description.h"
+#include "colmap_ext/lab_commands/synthetic_data_options.h"
+#include "colmap_ext/lab_commands/time_model_json.h"
 
 namespace rig_calibrator {
 namespace {
@@ -133,8 +136,11 @@ bool WriteRigGroundTruth(const RenderedDatasetPlan& plan,
     for (int c = 0; c < num_cameras; ++c) {
       rig_names.push_back(plan.RigImageName(c, static_cast<int>(f)));
       rig_camera_indices.push_back(c);
-      rig_cam_from_world.push_back(plan.rig.cam_from_rig[c] *
-                                   plan.rig.rig_from_world[f]);
+      rig_cam_from_world.push_back(
+          plan.HasTimeModel()
+              ? plan.RigImageCapture(c, static_cast<int>(f)).CamFromWorldAt(
+                    plan.rig.frameset_times_s[f] + plan.rig.time_offsets_s[c])
+              : plan.rig.cam_from_rig[c] * plan.rig.rig_from_world[f]);
     }
   }
   return WriteFileAtomically((folder / "rig_from_world.txt").string(),
@@ -171,16 +177,26 @@ bool WriteGroundTruth(const RenderedDatasetOptions& options,
           << "supersampling " << render_options.supersampling << "\n"
           << "noise_stddev " << render_options.noise_stddev << "\n"
           << "units meters, world z up\n";
+  if (plan.HasTimeModel()) {
+    summary << "frameset_rate_hz " << options.time_model.frameset_rate_hz
+            << "\n"
+            << "timestamp_tolerance_ns "
+            << std::llround(plan.TimestampTolerance()) << "\n";
+  }
   return WriteFileAtomically((folder / "dataset.txt").string(), summary.str(),
-                             error);
+                             error) &&
+         (!plan.HasTimeModel() ||
+          WriteTimeModelJson((folder / "time_model.json").string(),
+                             options.time_model, plan.frameset_names, plan.rig,
+                             error));
 }
 
 bool RenderAndWrite(const TexturedScene& scene, const CameraRays& rays,
-                    const Rigid3d& cam_from_world, const RenderOptions& options,
-                    uint64_t noise_seed, const fs::path& path,
-                    std::string* error) {
+                    const std::vector<Rigid3d>& cam_from_world_per_row,
+                    const RenderOptions& options, uint64_t noise_seed,
+                    const fs::path& path, std::string* error) {
   const colmap::Bitmap bitmap =
-      RenderImage(scene, rays, cam_from_world, options, noise_seed);
+      RenderImage(scene, rays, cam_from_world_per_row, options, noise_seed);
   if (bitmap.Width() == 0) {
     *error = "cannot render " + path.string();
     return false;
@@ -212,7 +228,9 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
     if (!MakeFolder(folder / "map_images", error)) return false;
     const CameraRays map_rays(plan.map_camera, render_options.supersampling);
     for (size_t i = 0; i < plan.map_image_names.size(); ++i) {
-      if (!RenderAndWrite(plan.scene, map_rays, plan.map_cam_from_world[i],
+      const std::vector<Rigid3d> map_cam_from_world(
+          map_rays.height(), plan.map_cam_from_world[i]);
+      if (!RenderAndWrite(plan.scene, map_rays, map_cam_from_world,
                           render_options, seed_base + i,
                           folder / "map_images" / plan.map_image_names[i],
                           error)) {
@@ -238,13 +256,19 @@ bool WriteRenderedDataset(const RenderedDatasetOptions& dataset_options,
                   << std::endl;
       }
       for (int f = 0; f < num_framesets; ++f) {
-        const Rigid3d cam_from_world =
-            plan.rig.cam_from_rig[c] * plan.rig.rig_from_world[f];
+        // Without a time model every row has the frameset's pose.
+        const std::vector<Rigid3d> cam_from_world_per_row =
+            plan.HasTimeModel()
+                ? CamFromWorldPerRow(plan.RigImageCapture(c, f), rays.height())
+                : std::vector<Rigid3d>(rays.height(),
+                                       plan.rig.cam_from_rig[c] *
+                                           plan.rig.rig_from_world[f]);
         const uint64_t noise_seed =
             seed_base + 0x80000000ull + c * num_framesets + f;
         if (!RenderAndWrite(
-                plan.scene, rays, cam_from_world, render_options, noise_seed,
-                folder / "rig_images" / plan.RigImageName(c, f), error)) {
+                plan.scene, rays, cam_from_world_per_row, render_options,
+                noise_seed, folder / "rig_images" / plan.RigImageName(c, f),
+                error)) {
           return false;
         }
       }
@@ -298,6 +322,8 @@ int RunRender(int argc, char** argv) {
             "Gaussian pixel noise in grey levels");
   AddOption(&description, "rgb", &render_options.as_rgb,
             "1: RGB images, 0: grey");
+  TimeModelArguments time_model;
+  AddTimeModelOptions(&description, &dataset_options.time_model, &time_model);
   AddOverwriteOption(&description, &overwrite);
   if (const std::optional<int> exit_code = ParseCommandLine(
           argc, argv, description,
@@ -316,7 +342,9 @@ int RunRender(int argc, char** argv) {
   }
   std::string error;
   RenderedDatasetPlan plan;
-  if (!PlanRenderedDataset(dataset_options, &plan, &error) ||
+  if (!ApplyTimeModelArguments(time_model, &dataset_options.time_model,
+                               &error) ||
+      !PlanRenderedDataset(dataset_options, &plan, &error) ||
       !WriteRenderedDataset(dataset_options, plan, render_options, output_path,
                             overwrite, &error)) {
     return PrintError(error);
@@ -326,6 +354,12 @@ int RunRender(int argc, char** argv) {
             << plan.rig.cameras.size() << " cameras x "
             << plan.frameset_names.size() << " framesets), ground_truth/"
             << std::endl;
+  if (plan.HasTimeModel()) {
+    std::cout << "Time model in ground_truth/time_model.json; the rig images "
+                 "are named by their capture times (ns): calibrate with "
+                 "--RigCalibrator.timestamp_tolerance "
+              << std::llround(plan.TimestampTolerance()) << std::endl;
+  }
   return EXIT_SUCCESS;
 }
 

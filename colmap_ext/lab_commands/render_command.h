@@ -22,6 +22,18 @@
 //                                   "camera_models cam0:OPENCV,..." (the
 //                                   true models, as
 //                                   --RigCalibrator.camera_model takes them)
+//
+// With a time model (--frameset_rate_hz > 0; the options of `synthetic`,
+// synthetic_data_options.h) every rig image is rendered at its own capture
+// time, each row of a rolling shutter at its own (rendered_dataset.h), and
+// named by its capture time in nanoseconds (rig_images/cam1/1240100000.png);
+// rig_from_world.txt names the framesets by cam0's time stamp and the
+// rig_model's image poses are those of the images' top rows. Also written:
+//     time_model.json               the frameset times, offsets and line
+//                                   delays (time_model_json.h)
+//     dataset.txt                   also "timestamp_tolerance_ns T": the
+//                                   --RigCalibrator.timestamp_tolerance that
+//                                   groups the images into framesets
 #pragma once
 
 #include <string>

@@ -3,7 +3,6 @@
 // feed benchmarks without images.
 #include <boost/filesystem.hpp>
 #include <iostream>
-#include <nlohmann/json.hpp>
 
 #include "colmap_ext/benchmarks/synthetic_map_model.h"
 #include "colmap_ext/commands/command_options.h"
@@ -14,6 +13,7 @@
 #include "colmap_ext/io/rig_description.h"
 #include "colmap_ext/lab_commands/lab_commands.h"
 #include "colmap_ext/lab_commands/synthetic_data_options.h"
+#include "colmap_ext/lab_commands/time_model_json.h"
 #include "src/synthetic/synthetic_rig.h"
 
 namespace rig_calibrator {
@@ -30,41 +30,6 @@ RigDescription DescribeGroundTruth(const RigGroundTruth& truth) {
     rig.cameras.push_back(camera);
   }
   return rig;
-}
-
-// ground_truth/time_model.json of a dataset with a time model: the
-// frameset rate, the rig's speed and turn rate, per camera its capture-time
-// offset and line delay, and per frameset its time (seconds); camera c
-// captures the row through pixel y of frameset f at
-// frameset_times_s[f] + time_offset_s + line_delay_s (y - 0.5).
-bool WriteTimeModelJson(const std::string& path,
-                        const SyntheticRigOptions& options,
-                        const RigDataset& dataset,
-                        const RigGroundTruth& truth, std::string* error) {
-  nlohmann::ordered_json json;
-  json["capture_time"] =
-      "camera c captures the row through pixel y (COLMAP pixels, the top "
-      "row's centre at y = 0.5) of frameset f at frameset_times_s[f] + "
-      "time_offset_s + line_delay_s * (y - 0.5) seconds";
-  json["frameset_rate_hz"] = options.frameset_rate_hz;
-  json["speed_m_s"] = options.speed_m_s;
-  json["max_turn_rate_deg_s"] = options.max_turn_rate_deg_s;
-  json["reference_camera"] = truth.camera_names[0];
-  nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
-  for (size_t c = 0; c < truth.cameras.size(); ++c) {
-    cameras.push_back({{"name", truth.camera_names[c]},
-                       {"time_offset_s", truth.time_offsets_s[c]},
-                       {"line_delay_s", truth.line_delays_s[c]},
-                       {"rows", truth.cameras[c].Height()}});
-  }
-  json["cameras"] = cameras;
-  nlohmann::ordered_json framesets = nlohmann::ordered_json::array();
-  for (size_t f = 0; f < truth.frameset_times_s.size(); ++f) {
-    framesets.push_back({{"name", dataset.frameset_names[f]},
-                         {"time_s", truth.frameset_times_s[f]}});
-  }
-  json["framesets"] = framesets;
-  return WriteFileAtomically(path, json.dump(2) + "\n", error);
 }
 
 }  // namespace
@@ -156,8 +121,8 @@ int RunSynthetic(int argc, char** argv) {
                                  &notes, write_error) &&
                (options.frameset_rate_hz == 0 ||
                 WriteTimeModelJson(folder + "/ground_truth/time_model.json",
-                                   options, rig.dataset, rig.truth,
-                                   write_error));
+                                   options, rig.dataset.frameset_names,
+                                   rig.truth, write_error));
       },
       &error);
   if (!written) {

@@ -26,8 +26,9 @@ struct TimeModelArguments {
   std::string camera_line_delays_us;   // "0,25,30,...": one per camera
 };
 
-// The time model of `rig_calibrator_lab synthetic`: --frameset_rate_hz,
-// --speed_m_s, --max_turn_rate_deg_s (bound to *options), and
+// The time model of `rig_calibrator_lab synthetic` and `render`:
+// --frameset_rate_hz, --speed_m_s, --max_turn_rate_deg_s (bound to
+// *options), and
 // --max_time_offset_ms, --camera_time_offsets_ms, --line_delay_us,
 // --camera_line_delays_us (bound to *arguments; ApplyTimeModelArguments
 // converts them after parsing).

@@ -7,8 +7,21 @@
 namespace rig_calibrator {
 
 Rigid3d ImageCapture::CamFromWorldAt(double time_s) const {
-  return cam_from_rig *
-         (trajectory->WorldFromBody(time_s) * body_from_rig).Inverse();
+  const Rigid3d world_from_body =
+      world_from_trajectory
+          ? *world_from_trajectory * trajectory->WorldFromBody(time_s)
+          : trajectory->WorldFromBody(time_s);
+  return cam_from_rig * (world_from_body * body_from_rig).Inverse();
+}
+
+std::vector<Rigid3d> CamFromWorldPerRow(const ImageCapture& capture,
+                                        int num_rows) {
+  std::vector<Rigid3d> poses;
+  poses.reserve(num_rows);
+  for (int row = 0; row < num_rows; ++row) {
+    poses.push_back(capture.CamFromWorldAt(capture.RowTime(row + 0.5)));
+  }
+  return poses;
 }
 
 Rigid3d RigFromWorldAtTime(const RigGroundTruth& truth, double time_s) {

@@ -30,6 +30,8 @@
 #include <colmap/base/camera.h>
 
 #include <Eigen/Core>
+#include <optional>
+#include <vector>
 
 #include "src/geometry/rigid3d.h"
 #include "src/synthetic/rig_trajectory.h"
@@ -40,6 +42,13 @@ namespace rig_calibrator {
 // The capture of one image: the rig's motion and the image's row times.
 struct ImageCapture {
   const RigTrajectory* trajectory = nullptr;
+  // Where the trajectory lies in the world: world_from_body(t) =
+  // world_from_trajectory * trajectory->WorldFromBody(t). Unset for the
+  // synthetic generator, whose trajectory is in the world frame (the
+  // identity; not composed, so its data stay bit for bit); a rendered
+  // dataset moves the trajectory onto each frameset's planned pose
+  // (rendered_dataset.h).
+  std::optional<Rigid3d> world_from_trajectory;
   Rigid3d body_from_rig;  // RigGroundTruth::body_from_rig
   Rigid3d cam_from_rig;
   double top_row_time_s = 0;  // t_f + delta_c: when y = 0.5 is captured
@@ -53,6 +62,13 @@ struct ImageCapture {
   // * body_from_rig)^-1 (as the ground truth's rig_from_world[f] at t_f).
   Rigid3d CamFromWorldAt(double time_s) const;
 };
+
+// The pose of every image row r = 0 .. num_rows - 1 as a renderer needs it:
+// cam_from_world(t(r + 0.5)), the pose when the row's pixel centres are
+// read out. A sensor row is exposed as a whole, so every point of a pixel
+// (any sample of it) is seen with its row's pose.
+std::vector<Rigid3d> CamFromWorldPerRow(const ImageCapture& capture,
+                                        int num_rows);
 
 // The rig pose at time t of a ground truth with a time model (its trajectory
 // set): (world_from_body(t) * body_from_rig)^-1.

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "src/synthetic/rig_presets.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -194,7 +196,60 @@ bool PlanRigSequence(const RenderedDatasetOptions& options,
   return true;
 }
 
+// The time model (options.time_model.frameset_rate_hz > 0; see the
+// header): the trajectory (its 4 phases drawn from *random after the rig
+// sequence's draws), the frameset times and names, the anchors W_f * B(t_f)^-1
+// and the offsets and line delays (DrawCaptureTimes with the dataset's seed).
+// Fails when a rig camera would stand in a wall when its top or bottom row
+// is taken.
+bool PlanTimeModel(const RenderedDatasetOptions& options,
+                   std::mt19937* random, RenderedDatasetPlan* plan,
+                   std::string* error) {
+  const SyntheticRigOptions& time_model = options.time_model;
+  RigGroundTruth& rig = plan->rig;
+  rig.trajectory.emplace(MakePresetDefinition(options.preset, 0).motion,
+                         time_model.speed_m_s, time_model.max_turn_rate_deg_s,
+                         /*rotation_only=*/false, random);
+  rig.body_from_rig = BodyFromRig(rig.cam_from_rig);
+  SyntheticRigOptions draws = time_model;
+  draws.seed = options.seed;
+  DrawCaptureTimes(draws, &rig);
+  const Rigid3d rig_from_body = rig.body_from_rig.Inverse();
+  for (int f = 0; f < options.num_framesets; ++f) {
+    const double time_s = (f + 1) / time_model.frameset_rate_hz;
+    rig.frameset_times_s.push_back(time_s);
+    plan->frameset_names[f] = Timestamp(time_s);
+    const Rigid3d world_from_body =
+        rig.rig_from_world[f].Inverse() * rig_from_body;
+    plan->world_from_trajectory.push_back(
+        world_from_body * rig.trajectory->WorldFromBody(time_s).Inverse());
+  }
+  for (int f = 0; f < options.num_framesets; ++f) {
+    for (size_t c = 0; c < rig.cameras.size(); ++c) {
+      const ImageCapture capture =
+          plan->RigImageCapture(static_cast<int>(c), f);
+      const double bottom_row_y = rig.cameras[c].Height() - 0.5;
+      for (const double y : {0.5, bottom_row_y}) {
+        const Eigen::Vector3d center =
+            capture.CamFromWorldAt(capture.RowTime(y)).Center();
+        if (!plan->scene.IsFree(center, kMinClearance)) {
+          *error = "rig camera " + rig.camera_names[c] + " of frameset " +
+                   std::to_string(f) +
+                   " would stand in a wall during its capture: the rig "
+                   "moves too far (speed_m_s, time offsets)";
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+std::string Timestamp(double time_s) {
+  return std::to_string(std::llround(time_s * 1e9));
+}
 
 bool RenderedDatasetOptions::Check(std::string* error) const {
   if (num_map_images < 3 || num_map_images > 100000) {
@@ -218,13 +273,48 @@ bool RenderedDatasetOptions::Check(std::string* error) const {
     *error = "rig_height must be in [0, 100) meters (0: the scene's)";
     return false;
   }
+  // The time model's own checks, for this preset and number of framesets.
+  SyntheticRigOptions time_options = time_model;
+  time_options.preset = preset;
+  time_options.num_framesets = num_framesets;
+  if (!time_options.Check(error)) return false;
+  const double quarter_period = 0.25 / time_model.frameset_rate_hz;
+  bool offsets_fit = time_model.max_time_offset_s <= quarter_period;
+  for (const double offset : time_model.time_offsets_s) {
+    offsets_fit &= std::abs(offset) <= quarter_period;
+  }
+  if (time_model.frameset_rate_hz > 0 && !offsets_fit) {
+    *error = "the time offsets (max_time_offset_s, time_offsets_s) must be "
+             "within a quarter of the frameset period, " +
+             std::to_string(quarter_period) +
+             " s, for the framesets to be told apart by their time stamps";
+    return false;
+  }
   return true;
 }
 
 std::string RenderedDatasetPlan::RigImageName(int camera_index,
                                               int frameset_index) const {
+  if (HasTimeModel()) {
+    return rig.camera_names[camera_index] + "/" +
+           Timestamp(rig.frameset_times_s[frameset_index] +
+                     rig.time_offsets_s[camera_index]) +
+           ".png";
+  }
   return rig.camera_names[camera_index] + "/" + frameset_names[frameset_index] +
          ".png";
+}
+
+ImageCapture RenderedDatasetPlan::RigImageCapture(int camera_index,
+                                                  int frameset_index) const {
+  ImageCapture capture = CaptureOfImage(rig, camera_index, frameset_index);
+  capture.world_from_trajectory = world_from_trajectory[frameset_index];
+  return capture;
+}
+
+double RenderedDatasetPlan::TimestampTolerance() const {
+  // t_0 = 1 / frameset_rate_hz is the period.
+  return 0.5e9 * rig.frameset_times_s[0];
 }
 
 bool PlanRenderedDataset(const RenderedDatasetOptions& options,
@@ -232,10 +322,13 @@ bool PlanRenderedDataset(const RenderedDatasetOptions& options,
   if (!options.Check(error)) return false;
   *plan = RenderedDatasetPlan();
   plan->scene = TexturedScene::Make(options.scene, options.seed);
-  // One random stream: the map sequence's draws, then the rig's.
+  // One random stream: the map sequence's draws, then the rig's, then the
+  // trajectory's phases.
   std::mt19937 random(options.seed);
   return PlanMapSequence(options, &random, plan, error) &&
-         PlanRigSequence(options, &random, plan, error);
+         PlanRigSequence(options, &random, plan, error) &&
+         (options.time_model.frameset_rate_hz == 0 ||
+          PlanTimeModel(options, &random, plan, error));
 }
 
 }  // namespace rig_calibrator

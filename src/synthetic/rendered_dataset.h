@@ -10,6 +10,20 @@
 // images change by similar amounts of translation and rotation (good overlap
 // for sequential matching). Deterministic for a seed (the seed also selects
 // the scene's textures).
+//
+// With a time model (time_model.frameset_rate_hz > 0) every rig image is
+// taken at its own time and each row of a rolling shutter at its own
+// (capture_model.h), with the synthetic generator's continuous trajectory
+// (rig_trajectory.h) and capture-time offsets and line delays
+// (DrawCaptureTimes). The planned rig poses are seconds apart and need not
+// follow one trajectory, so around frameset f the trajectory is moved
+// rigidly onto the planned pose:
+//   world_from_body(t) = W_f * B(t_f)^-1 * B(t),
+// W_f the planned world_from_body, B the trajectory's; the rig passes
+// through its planned pose at t_f with the trajectory's velocities (body
+// frame), and an image needs the motion only within its offset and readout
+// (tens of milliseconds) of t_f. Frameset f's time is t_f = (f + 1) /
+// frameset_rate_hz, so that every capture time is positive.
 #pragma once
 
 #include <colmap/base/camera.h>
@@ -18,6 +32,7 @@
 #include <vector>
 
 #include "src/geometry/rigid3d.h"
+#include "src/synthetic/capture_model.h"
 #include "src/synthetic/synthetic_rig.h"
 #include "src/synthetic/textured_scene.h"
 
@@ -36,6 +51,14 @@ struct RenderedDatasetOptions {
   // Height of the rig's camera centers' mean above the ground; 0: the
   // scene's eye height.
   double rig_height = 0;
+  // The rig images' time model: its frameset_rate_hz (0, the default: every
+  // frameset at one instant, global shutters; the images of earlier
+  // versions), speed_m_s, max_turn_rate_deg_s, time offsets and line delays
+  // (SyntheticRigOptions's meaning and checks; its other fields are not
+  // used). Every offset must be within a quarter of the frameset period, so
+  // that the images of a frameset lie within half a period of each other and
+  // the framesets a period apart (RenderedDatasetPlan::TimestampTolerance).
+  SyntheticRigOptions time_model;
 
   // False (with a message) for values outside their ranges.
   bool Check(std::string* error) const;
@@ -47,17 +70,38 @@ struct RenderedDatasetPlan {
   std::vector<std::string> map_image_names;  // "map_000012.png"
   std::vector<Rigid3d> map_cam_from_world;
   // The preset's true cameras and cam_from_rig, and rig_from_world per
-  // frameset.
+  // frameset (the planned poses, at t_f). With a time model also its
+  // frameset times, offsets, line delays, trajectory and body_from_rig.
   RigGroundTruth rig;
-  std::vector<std::string> frameset_names;  // "000012"
+  // "000012"; with a time model the time stamp of t_f (Timestamp).
+  std::vector<std::string> frameset_names;
+  // With a time model, per frameset: W_f * B(t_f)^-1 (above), where the
+  // trajectory lies in the world around frameset f.
+  std::vector<Rigid3d> world_from_trajectory;
 
+  bool HasTimeModel() const { return rig.trajectory.has_value(); }
   // "cam3/000012.png": the image of a rig camera in a frameset, relative to
-  // the rig image folder.
+  // the rig image folder; with a time model "cam3/<Timestamp>.png" of the
+  // image's capture time t_f + delta_c (its top row's), so that images of
+  // a frameset have different, close numeric names, as an unsynchronized
+  // rig records them.
   std::string RigImageName(int camera_index, int frameset_index) const;
+  // With a time model: how camera `camera_index` took its image of frameset
+  // `frameset_index` (the row times and the motion).
+  ImageCapture RigImageCapture(int camera_index, int frameset_index) const;
+  // With a time model: the rig_calibrator --RigCalibrator.timestamp_tolerance
+  // (in the time stamps' unit, nanoseconds) that groups the images into the
+  // framesets: half the frameset period.
+  double TimestampTolerance() const;
 };
 
+// A time in seconds as the integer number of nanoseconds that names its
+// images ("1200000000" for 1.2 s; --RigCalibrator.timestamp_unit_s 1e-9).
+std::string Timestamp(double time_s);
+
 // Fails (with a message) for invalid options, or when a camera would stand
-// inside or within 0.25 m of a surface.
+// inside or within 0.25 m of a surface (with a time model: when its top or
+// bottom row is taken).
 bool PlanRenderedDataset(const RenderedDatasetOptions& options,
                          RenderedDatasetPlan* plan, std::string* error);
 

@@ -41,15 +41,21 @@ double GaussianNoise(uint64_t seed, int x, int y, int channel) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
+// A row's camera pose in the form the ray casting uses.
+struct RowPose {
+  Eigen::Matrix3d world_from_cam_rotation;
+  Eigen::Vector3d center;
+};
+
 // Face index of the hit of each pixel's center ray (row-major), kSky for
 // rays that hit nothing, kNoRay for pixels without a ray; the hits in *hits.
 constexpr int kNoRay = -2;
 constexpr int kSky = -1;
 
-std::vector<int> IntersectCenterRays(
-    const TexturedScene& scene, const CameraRays& rays,
-    const Eigen::Matrix3d& world_from_cam_rotation,
-    const Eigen::Vector3d& center, std::vector<SceneHit>* hits) {
+std::vector<int> IntersectCenterRays(const TexturedScene& scene,
+                                     const CameraRays& rays,
+                                     const std::vector<RowPose>& row_poses,
+                                     std::vector<SceneHit>* hits) {
   const int width = rays.width();
   const int height = rays.height();
   const size_t num_pixels = static_cast<size_t>(width) * height;
@@ -57,13 +63,14 @@ std::vector<int> IntersectCenterRays(
   std::vector<int> faces(num_pixels, kNoRay);
 #pragma omp parallel for schedule(dynamic)
   for (int y = 0; y < height; ++y) {
+    const RowPose& pose = row_poses[y];
     for (int x = 0; x < width; ++x) {
       const size_t pixel = static_cast<size_t>(y) * width + x;
       const Eigen::Vector3f& camera_ray = rays.CenterRay(x, y);
       if (camera_ray.isZero()) continue;
       const Eigen::Vector3d direction =
-          world_from_cam_rotation * camera_ray.cast<double>();
-      faces[pixel] = scene.Intersect(center, direction, &(*hits)[pixel])
+          pose.world_from_cam_rotation * camera_ray.cast<double>();
+      faces[pixel] = scene.Intersect(pose.center, direction, &(*hits)[pixel])
                          ? (*hits)[pixel].face
                          : kSky;
     }
@@ -180,7 +187,7 @@ CameraRays::CameraRays(const colmap::Camera& camera, int supersampling)
 }
 
 colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
-                           const Rigid3d& cam_from_world,
+                           const std::vector<Rigid3d>& cam_from_world_per_row,
                            const RenderOptions& options, uint64_t noise_seed) {
   colmap::Bitmap bitmap;
   std::string error;
@@ -195,11 +202,19 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
   }
   const int width = rays.width();
   const int height = rays.height();
+  if (static_cast<int>(cam_from_world_per_row.size()) != height) {
+    LOG(ERROR) << "Cannot render " << height << " rows with "
+               << cam_from_world_per_row.size() << " row poses";
+    return bitmap;
+  }
   const int channels = options.as_rgb ? 3 : 1;
   const int num_samples = rays.NumSamples();
-  const Eigen::Matrix3d world_from_cam_rotation =
-      cam_from_world.RotationMatrix().transpose();
-  const Eigen::Vector3d center = cam_from_world.Center();
+  std::vector<RowPose> row_poses(height);
+  for (int y = 0; y < height; ++y) {
+    row_poses[y].world_from_cam_rotation =
+        cam_from_world_per_row[y].RotationMatrix().transpose();
+    row_poses[y].center = cam_from_world_per_row[y].Center();
+  }
   // Grazing incidence stretches the footprint by 1 / cos; the cap keeps
   // far, grazing floors from blurring to a flat grey.
   constexpr double kMinCosine = 0.2;
@@ -222,14 +237,17 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
   // Pass 1: what the center ray of every pixel hits.
   const size_t num_pixels = static_cast<size_t>(width) * height;
   std::vector<SceneHit> center_hits;
-  const std::vector<int> center_faces = IntersectCenterRays(
-      scene, rays, world_from_cam_rotation, center, &center_hits);
+  const std::vector<int> center_faces =
+      IntersectCenterRays(scene, rays, row_poses, &center_hits);
 
   // Pass 2: one pre-filtered sample inside a face, supersampling where the
   // surface changes.
   std::vector<uint8_t> pixels(num_pixels * channels);
 #pragma omp parallel for schedule(dynamic)
   for (int y = 0; y < height; ++y) {
+    const Eigen::Matrix3d& world_from_cam_rotation =
+        row_poses[y].world_from_cam_rotation;
+    const Eigen::Vector3d& center = row_poses[y].center;
     for (int x = 0; x < width; ++x) {
       const size_t pixel = static_cast<size_t>(y) * width + x;
       const int face = center_faces[pixel];
@@ -270,6 +288,15 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
   }
 
   return ToBitmap(pixels, width, height, options.as_rgb);
+}
+
+colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
+                           const Rigid3d& cam_from_world,
+                           const RenderOptions& options, uint64_t noise_seed) {
+  return RenderImage(
+      scene, rays,
+      std::vector<Rigid3d>(std::max(0, rays.height()), cam_from_world),
+      options, noise_seed);
 }
 
 colmap::Bitmap RenderImage(const TexturedScene& scene,

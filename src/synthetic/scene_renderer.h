@@ -90,6 +90,15 @@ colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
                            const Rigid3d& cam_from_world,
                            const RenderOptions& options, uint64_t noise_seed);
 
+// The same with a pose per image row (a rolling shutter, or a global one
+// with every row's pose the same): every pixel of row r (its centre ray,
+// its samples) is cast from cam_from_world_per_row[r], e.g. the poses of
+// CamFromWorldPerRow (capture_model.h). Logs an error and returns an empty
+// bitmap unless there is one pose per row.
+colmap::Bitmap RenderImage(const TexturedScene& scene, const CameraRays& rays,
+                           const std::vector<Rigid3d>& cam_from_world_per_row,
+                           const RenderOptions& options, uint64_t noise_seed);
+
 // The same, computing the camera's rays first.
 colmap::Bitmap RenderImage(const TexturedScene& scene,
                            const colmap::Camera& camera,

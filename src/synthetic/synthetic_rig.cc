@@ -165,8 +165,7 @@ void GenerateImage(const SyntheticRigOptions& options,
 // The time model of options.frameset_rate_hz > 0: the continuous
 // trajectory (its phases drawn from *rng, as the per-frameset trajectory's),
 // the frameset times and rig poses, and each camera's time offset and line
-// delay, given or drawn from a stream of their own (so that the offsets do
-// not change the rest of the data's draws).
+// delay (DrawCaptureTimes).
 void AddTimeModel(const SyntheticRigOptions& options,
                   const MotionProfile& motion, const Rigid3d& body_from_rig,
                   std::mt19937* rng, RigGroundTruth* truth) {
@@ -179,24 +178,7 @@ void AddTimeModel(const SyntheticRigOptions& options,
     truth->frameset_times_s.push_back(time_s);
     truth->rig_from_world.push_back(RigFromWorldAtTime(*truth, time_s));
   }
-  const int num_cameras = truth->cameras.size();
-  std::mt19937 time_rng(options.seed + 4);
-  std::uniform_real_distribution<double> offset(-options.max_time_offset_s,
-                                                options.max_time_offset_s);
-  std::uniform_real_distribution<double> line_delay(options.min_line_delay_s,
-                                                    options.max_line_delay_s);
-  truth->time_offsets_s = options.time_offsets_s;
-  if (truth->time_offsets_s.empty()) {
-    for (int c = 0; c < num_cameras; ++c) {
-      truth->time_offsets_s.push_back(c == 0 ? 0.0 : offset(time_rng));
-    }
-  }
-  truth->line_delays_s = options.line_delays_s;
-  if (truth->line_delays_s.empty()) {
-    for (int c = 0; c < num_cameras; ++c) {
-      truth->line_delays_s.push_back(line_delay(time_rng));
-    }
-  }
+  DrawCaptureTimes(options, truth);
 }
 
 // Changes the map's unit (SyntheticRigOptions::map_scale): x' = s x for
@@ -325,6 +307,28 @@ bool CheckTimeModel(const SyntheticRigOptions& options,
 }
 
 }  // namespace
+
+void DrawCaptureTimes(const SyntheticRigOptions& options,
+                      RigGroundTruth* truth) {
+  const int num_cameras = truth->cameras.size();
+  std::mt19937 time_rng(options.seed + 4);
+  std::uniform_real_distribution<double> offset(-options.max_time_offset_s,
+                                                options.max_time_offset_s);
+  std::uniform_real_distribution<double> line_delay(options.min_line_delay_s,
+                                                    options.max_line_delay_s);
+  truth->time_offsets_s = options.time_offsets_s;
+  if (truth->time_offsets_s.empty()) {
+    for (int c = 0; c < num_cameras; ++c) {
+      truth->time_offsets_s.push_back(c == 0 ? 0.0 : offset(time_rng));
+    }
+  }
+  truth->line_delays_s = options.line_delays_s;
+  if (truth->line_delays_s.empty()) {
+    for (int c = 0; c < num_cameras; ++c) {
+      truth->line_delays_s.push_back(line_delay(time_rng));
+    }
+  }
+}
 
 std::string FramesetName(int frameset) {
   char name[32];

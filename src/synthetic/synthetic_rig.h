@@ -200,6 +200,15 @@ struct SyntheticRig {
 // rig without images.
 SyntheticRig GenerateSyntheticRig(const SyntheticRigOptions& options);
 
+// Per camera of truth (its cameras set) the capture-time offset and line
+// delay of the time model of `options` (frameset_rate_hz > 0): given
+// (time_offsets_s, line_delays_s) or drawn uniformly in their ranges from a
+// random stream of their own (seed + 4), so that they do not change the
+// other draws of the data and the same seed gives the same values whatever
+// the preset. Sets truth->time_offsets_s and truth->line_delays_s.
+void DrawCaptureTimes(const SyntheticRigOptions& options,
+                      RigGroundTruth* truth);
+
 // Keeps the rig correspondences of points that at least two map images
 // observe, as in a COLMAP map, where every point has a track (with map
 // images; without, nothing changes): then every point can be refined with

@@ -128,6 +128,8 @@ TEST_F(RenderCommandOutput, WritesTheTrueRig) {
       RotationDifferenceDeg(rigs[0].cameras[1].cam_from_rig->rotation,
                             dataset_->plan.rig.cam_from_rig[1].rotation),
       0, 1e-9);
+  // Without a time model there is no time_model.json.
+  EXPECT_FALSE(fs::exists(truth_ + "time_model.json"));
 }
 
 // rig_from_world per frameset and the true poses as COLMAP models.
@@ -213,6 +215,75 @@ TEST(RenderCommand, CommandLineErrorsFailCleanly) {
   EXPECT_EQ(run({"--output_path", out, "--supersampling", "0"}), EXIT_FAILURE);
   EXPECT_EQ(run({"--preset", "ring5"}), EXIT_FAILURE);  // no output path
   EXPECT_EQ(run({"--help"}), EXIT_SUCCESS);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// With a time model (offsets only: the stereo pair's cam1 30 ms late): the
+// images are named by their capture times, cam1's image is the
+// global-shutter image at t_f + 30 ms, and the ground truth holds the times
+// and the tolerance that groups the framesets.
+TEST(RenderCommand, TimeModelRendersEachImageAtItsCaptureTime) {
+  SmallDataset dataset;
+  dataset.options.time_model.frameset_rate_hz = 5;
+  dataset.options.time_model.time_offsets_s = {0, 0.03};
+  std::string error;
+  ASSERT_TRUE(PlanRenderedDataset(dataset.options, &dataset.plan, &error))
+      << error;
+  testing::ScopedTempDir temp;
+  const std::string out = temp.File("dataset");
+  ASSERT_TRUE(WriteRenderedDataset(dataset.options, dataset.plan,
+                                   dataset.render, out, false, &error))
+      << error;
+  const RenderedDatasetPlan& plan = dataset.plan;
+  EXPECT_EQ(plan.RigImageName(1, 1), "cam1/430000000.png");
+  colmap::Bitmap written;
+  ASSERT_TRUE(written.Read(out + "/rig_images/cam1/430000000.png", true));
+  const Rigid3d at_capture_time =
+      plan.RigImageCapture(1, 1).CamFromWorldAt(0.4 + 0.03);
+  const uint64_t noise_seed = (4ull << 32) + 0x80000000ull + 1 * 2 + 1;
+  EXPECT_EQ(written.ConvertToRowMajorArray(),
+            RenderImage(plan.scene, plan.rig.cameras[1], at_capture_time,
+                        dataset.render, noise_seed)
+                .ConvertToRowMajorArray());
+  EXPECT_TRUE(fs::is_regular_file(out + "/rig_images/cam0/400000000.png"));
+
+  const std::vector<std::string> summary =
+      Lines(out + "/ground_truth/dataset.txt");
+  EXPECT_NE(std::find(summary.begin(), summary.end(),
+                      "timestamp_tolerance_ns 100000000"),
+            summary.end());
+  std::ifstream json_file(out + "/ground_truth/time_model.json");
+  std::stringstream json;
+  json << json_file.rdbuf();
+  EXPECT_NE(json.str().find("\"time_offset_s\": 0.03"), std::string::npos)
+      << json.str();
+  EXPECT_NE(json.str().find("\"name\": \"400000000\""), std::string::npos);
+  // The rig model's image pose is the image's (its top row's).
+  colmap::Reconstruction rig_model;
+  rig_model.ReadText(out + "/ground_truth/rig_model");
+  const colmap::Image* image = rig_model.FindImageWithName(
+      "cam1/430000000.png");
+  ASSERT_NE(image, nullptr);
+  EXPECT_LT((image->Tvec() - at_capture_time.translation).norm(), 1e-9);
+}
+
+TEST(RenderCommand, TimeModelOptionErrorsNameTheOption) {
+  testing::ScopedTempDir temp;
+  const std::string out = temp.File("dataset");
+  auto run = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"rig_calibrator", "--output_path", out,
+                               "--preset", "stereo_pair",
+                               "--num_map_images", "3", "--num_framesets",
+                               "1"});
+    std::vector<char*> argv;
+    for (std::string& arg : args) argv.push_back(arg.data());
+    return RunRender(static_cast<int>(argv.size()), argv.data());
+  };
+  EXPECT_EQ(run({"--frameset_rate_hz", "5", "--line_delay_us", "20,x"}),
+            EXIT_FAILURE);
+  EXPECT_EQ(run({"--line_delay_us", "20"}), EXIT_FAILURE);  // no rate
+  EXPECT_EQ(run({"--frameset_rate_hz", "10", "--max_time_offset_ms", "50"}),
+            EXIT_FAILURE);
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace rig_calibrator {
@@ -131,6 +132,91 @@ TEST(RenderedDataset, RejectsInvalidOptions) {
   options.rig_height = 2.95;  // cameras in the room's ceiling
   EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
   EXPECT_NE(error.find("would stand in a wall"), std::string::npos) << error;
+}
+
+// The helmet with a time model at 5 Hz: offsets in +-50 ms, 20-30 us per row.
+RenderedDatasetOptions TimeModelOptions() {
+  RenderedDatasetOptions options =
+      Options(RigPreset::kFisheyeHelmet5, SceneType::kRoom);
+  options.num_framesets = 4;
+  options.time_model.frameset_rate_hz = 5;
+  options.time_model.max_time_offset_s = 0.05;
+  options.time_model.min_line_delay_s = 20e-6;
+  options.time_model.max_line_delay_s = 30e-6;
+  return options;
+}
+
+// The trajectory is moved onto every planned pose: at t_f the rig is where
+// the plan puts it, and it turns at the trajectory's angular speed; images
+// are named by their capture times.
+TEST(RenderedDataset, TimeModelPassesThroughThePlannedPoses) {
+  RenderedDatasetPlan plan;
+  std::string error;
+  const RenderedDatasetOptions options = TimeModelOptions();
+  ASSERT_TRUE(PlanRenderedDataset(options, &plan, &error)) << error;
+  ASSERT_TRUE(plan.HasTimeModel());
+  const RigGroundTruth& rig = plan.rig;
+  ASSERT_EQ(rig.time_offsets_s.size(), 5u);
+  EXPECT_EQ(rig.time_offsets_s[0], 0);
+  for (int c = 0; c < 5; ++c) {
+    EXPECT_LE(std::abs(rig.time_offsets_s[c]), 0.05);
+    EXPECT_GE(rig.line_delays_s[c], 20e-6);
+    EXPECT_LE(rig.line_delays_s[c], 30e-6);
+  }
+  EXPECT_NE(rig.time_offsets_s[1], 0);
+  EXPECT_EQ(plan.TimestampTolerance(), 1e8);  // half of 200 ms, in ns
+  for (int f = 0; f < options.num_framesets; ++f) {
+    const double time_s = (f + 1) / 5.0;
+    EXPECT_DOUBLE_EQ(rig.frameset_times_s[f], time_s);
+    EXPECT_EQ(plan.frameset_names[f], Timestamp(time_s));
+    for (int c = 0; c < 5; ++c) {
+      EXPECT_EQ(plan.RigImageName(c, f),
+                "cam" + std::to_string(c) + "/" +
+                    Timestamp(time_s + rig.time_offsets_s[c]) + ".png");
+      const ImageCapture capture = plan.RigImageCapture(c, f);
+      const Rigid3d planned = rig.cam_from_rig[c] * rig.rig_from_world[f];
+      const Rigid3d at_frameset_time = capture.CamFromWorldAt(time_s);
+      EXPECT_LT(RotationDifferenceRad(at_frameset_time.rotation,
+                                      planned.rotation),
+                1e-12);
+      EXPECT_LT((at_frameset_time.translation - planned.translation).norm(),
+                1e-12);
+    }
+    constexpr double kStep = 1e-4;
+    const ImageCapture capture = plan.RigImageCapture(0, f);
+    const double angular_speed =
+        RotationDifferenceRad(capture.CamFromWorldAt(time_s - kStep).rotation,
+                              capture.CamFromWorldAt(time_s + kStep).rotation) /
+        (2 * kStep);
+    EXPECT_NEAR(angular_speed, rig.trajectory->AngularVelocity(time_s).norm(),
+                1e-3 * angular_speed);
+  }
+  EXPECT_EQ(Timestamp(1.2), "1200000000");
+  // Without a time model: no times, the frameset names of earlier versions.
+  ASSERT_TRUE(PlanRenderedDataset(
+      Options(RigPreset::kFisheyeHelmet5, SceneType::kRoom), &plan, &error));
+  EXPECT_FALSE(plan.HasTimeModel());
+  EXPECT_EQ(plan.frameset_names[0], "000000");
+  EXPECT_EQ(plan.RigImageName(1, 0), "cam1/000000.png");
+}
+
+TEST(RenderedDataset, RejectsInvalidTimeModels) {
+  RenderedDatasetPlan plan;
+  std::string error;
+  RenderedDatasetOptions options = TimeModelOptions();
+  options.time_model.frameset_rate_hz = 10;  // +-50 ms > 100 ms / 4
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("quarter of the frameset period"), std::string::npos)
+      << error;
+  options = TimeModelOptions();
+  options.time_model.frameset_rate_hz = 0;  // line delays without times
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("frameset_rate_hz > 0"), std::string::npos) << error;
+  options = TimeModelOptions();
+  options.time_model.max_time_offset_s = 0;
+  options.time_model.time_offsets_s = {0, 0.01};  // 2 of 5 cameras
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("time_offsets_s"), std::string::npos) << error;
 }
 
 }  // namespace rendered_dataset_test

@@ -5,8 +5,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <random>
 
+#include "src/synthetic/capture_model.h"
 #include "src/synthetic/rendered_dataset.h"
+#include "src/synthetic/rig_trajectory.h"
 #include "src/synthetic/synthetic_rig.h"
 #include "src/synthetic/textured_scene.h"
 #include "tests/testing.h"
@@ -318,6 +322,177 @@ TEST(SceneRenderer, SiftFindsThousandsOfFeatures) {
               << std::endl;
     EXPECT_GT(keypoints.size(), 1000u) << SceneTypeName(type);
   }
+}
+
+// The position of the patch of `reference` (levels, row-major, width
+// `reference_width`) of radius kPatchRadius around `reference_point` in
+// `image` (width `image_width`): the best normalized cross-correlation
+// within `search_radius` px of `start`, on a 1 px grid, then refined on a
+// 1/16 px grid within 1 px.
+constexpr int kPatchRadius = 10;
+Eigen::Vector2d FindPatch(const std::vector<double>& reference,
+                          int reference_width,
+                          const Eigen::Vector2d& reference_point,
+                          const std::vector<double>& image, int image_width,
+                          const Eigen::Vector2d& start, double search_radius,
+                          double* best_score) {
+  std::vector<double> patch;
+  for (int dy = -kPatchRadius; dy <= kPatchRadius; ++dy) {
+    for (int dx = -kPatchRadius; dx <= kPatchRadius; ++dx) {
+      patch.push_back(Sample(reference, reference_width,
+                             reference_point + Eigen::Vector2d(dx, dy)));
+    }
+  }
+  auto score_at = [&](const Eigen::Vector2d& point) {
+    std::vector<double> candidate;
+    for (int dy = -kPatchRadius; dy <= kPatchRadius; ++dy) {
+      for (int dx = -kPatchRadius; dx <= kPatchRadius; ++dx) {
+        candidate.push_back(
+            Sample(image, image_width, point + Eigen::Vector2d(dx, dy)));
+      }
+    }
+    return NormalizedCrossCorrelation(patch, candidate);
+  };
+  *best_score = -2;
+  Eigen::Vector2d best = start;
+  auto search = [&](const Eigen::Vector2d& center, double radius,
+                    double step) {
+    for (double sy = -radius; sy <= radius; sy += step) {
+      for (double sx = -radius; sx <= radius; sx += step) {
+        const Eigen::Vector2d point = center + Eigen::Vector2d(sx, sy);
+        const double score = score_at(point);
+        if (score > *best_score) {
+          *best_score = score;
+          best = point;
+        }
+      }
+    }
+  };
+  search(start, std::ceil(search_radius), 1.0);
+  search(best, 1.0, 1.0 / 16);
+  return best;
+}
+
+// A capture of a forward-looking PINHOLE camera on the synthetic trajectory,
+// placed so that at `time_s` the camera stands at `center` looking along
+// world +x, at the time of the trajectory's fastest turn in its first 10 s.
+struct MovingCamera {
+  colmap::Camera camera =
+      MakeCamera("PINHOLE", 320, 240, {250, 250, 160, 120});
+  std::optional<RigTrajectory> trajectory;
+  ImageCapture capture;
+
+  MovingCamera(const Eigen::Vector3d& center, double speed_m_s,
+               double turn_rate_deg_s) {
+    std::mt19937 rng(7);
+    trajectory.emplace(MotionProfile(), speed_m_s, turn_rate_deg_s,
+                       /*rotation_only=*/false, &rng);
+    double time_s = 0;
+    for (double t = 0; t < 10; t += 0.01) {
+      if (trajectory->AngularVelocity(t).norm() >
+          trajectory->AngularVelocity(time_s).norm()) {
+        time_s = t;
+      }
+    }
+    capture.trajectory = &*trajectory;
+    // The camera is the rig; the body looks along its x axis.
+    capture.body_from_rig = LookingAlongX(Eigen::Vector3d::Zero()).Inverse();
+    capture.world_from_trajectory =
+        Rigid3d(Eigen::Matrix3d::Identity(), center) *
+        trajectory->WorldFromBody(time_s).Inverse();
+    capture.top_row_time_s = time_s;
+  }
+};
+
+// A rolling-shutter image shows each scene point where the rolling-shutter
+// projection puts it: the point seen at pixel (200.5, 180.5) by the pose of
+// row 180 is found there (patch of a global-shutter image at that row's
+// time), sub-pixel, while in a global-shutter image at the top row's time it
+// is where that pose projects it, several pixels away.
+TEST(SceneRenderer, RollingShutterShowsPointsAtTheirRollingShutterProjection) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 3);
+  MovingCamera moving(Eigen::Vector3d(1.5, -0.3, 1.5), 1.5, 120);
+  ImageCapture& capture = moving.capture;
+  capture.line_delay_s = 100e-6;  // 24 ms readout of 240 rows
+  const colmap::Camera& camera = moving.camera;
+  const CameraRays rays(camera, 2);
+
+  const Eigen::Vector2d pixel(200.5, 180.5);
+  const Rigid3d row_pose = capture.CamFromWorldAt(capture.RowTime(pixel.y()));
+  SceneHit hit;
+  ASSERT_TRUE(scene.Intersect(
+      row_pose.Center(),
+      row_pose.rotation.conjugate() *
+          camera.ImageToWorld(pixel).homogeneous().normalized(),
+      &hit));
+  const Eigen::Vector3d point = hit.point;
+  Eigen::Vector2d rolling;
+  ASSERT_TRUE(ProjectWithRollingShutter(camera, capture, point, &rolling));
+  EXPECT_LT((rolling - pixel).norm(), 1e-6);
+  const Rigid3d top_pose = capture.CamFromWorldAt(capture.top_row_time_s);
+  const Eigen::Vector2d global =
+      camera.WorldToImage((top_pose * point).hnormalized());
+  // 180 rows of 100 us at the turn: the pose changed by several pixels.
+  const double expected_shift = (global - rolling).norm();
+  ASSERT_GT(expected_shift, 3.0);
+
+  const std::vector<double> rolling_image = GreyLevels(RenderImage(
+      scene, rays, CamFromWorldPerRow(capture, camera.Height()),
+      GreyNoiseless(), 0));
+  const std::vector<double> at_row_time =
+      GreyLevels(RenderImage(scene, rays, row_pose, GreyNoiseless(), 0));
+  const std::vector<double> at_top_time =
+      GreyLevels(RenderImage(scene, rays, top_pose, GreyNoiseless(), 0));
+  double score = 0;
+  // Searched from the global-shutter projection, found at the rolling one.
+  const Eigen::Vector2d found =
+      FindPatch(at_row_time, 320, pixel, rolling_image, 320, global,
+                expected_shift + 3, &score);
+  std::cout << "rolling-shutter projection " << rolling.transpose()
+            << ", global-shutter (top row) " << global.transpose()
+            << ", found " << found.transpose() << " (NCC " << score << ")"
+            << std::endl;
+  EXPECT_GT(score, 0.9);
+  EXPECT_LT((found - rolling).norm(), 0.25);
+  // The same patch in the global-shutter image at the top row's time lies at
+  // the global-shutter projection: the difference is the expected one.
+  const Eigen::Vector2d found_global =
+      FindPatch(at_row_time, 320, pixel, at_top_time, 320, rolling,
+                expected_shift + 3, &score);
+  EXPECT_GT(score, 0.9);
+  EXPECT_LT((found_global - global).norm(), 0.25);
+  EXPECT_NEAR((found_global - found).norm(), expected_shift, 0.35);
+}
+
+// With a capture-time offset and no line delay every row has the pose at the
+// shifted time: the image is the global-shutter image at t_f + delta_c, bit
+// for bit, and not the one at t_f.
+TEST(SceneRenderer, OffsetOnlyCaptureIsTheGlobalShutterImageAtItsTime) {
+  const TexturedScene scene = TexturedScene::Make(SceneType::kRoom, 3);
+  MovingCamera moving(Eigen::Vector3d(1.5, -0.3, 1.5), 1.5, 60);
+  ImageCapture& capture = moving.capture;
+  const double frameset_time_s = capture.top_row_time_s;
+  capture.top_row_time_s += 0.03;  // delta_c = 30 ms
+  const CameraRays rays(moving.camera, 2);
+  RenderOptions options;  // RGB with noise
+  const std::vector<uint8_t> offset_only =
+      RenderImage(scene, rays,
+                  CamFromWorldPerRow(capture, moving.camera.Height()), options,
+                  5)
+          .ConvertToRowMajorArray();
+  EXPECT_EQ(offset_only, RenderImage(scene, rays,
+                                     capture.CamFromWorldAt(frameset_time_s +
+                                                            0.03),
+                                     options, 5)
+                             .ConvertToRowMajorArray());
+  EXPECT_NE(offset_only,
+            RenderImage(scene, rays, capture.CamFromWorldAt(frameset_time_s),
+                        options, 5)
+                .ConvertToRowMajorArray());
+  // One pose per row is required.
+  EXPECT_EQ(RenderImage(scene, rays, std::vector<Rigid3d>(3), options, 5)
+                .Width(),
+            0);
 }
 
 }  // namespace scene_renderer_test
