@@ -182,6 +182,14 @@ const DistortionMapping kDistortionMappings[] = {
 // The timing fields of a camera (see the header).
 void WriteTiming(const RigDescriptionCamera& camera, std::ostringstream* yaml) {
   const CameraTiming& timing = *camera.timing;
+  if (camera.timestamp_offset_s != 0) {
+    *yaml << "  # timeshift_cam_imu = the capture-time offset against the "
+             "frameset times ("
+          << FormatYamlFloat(timing.time_offset_s)
+          << " s) - the offset removed from the camera's names before "
+             "grouping ("
+          << FormatYamlFloat(camera.timestamp_offset_s) << " s)\n";
+  }
   *yaml << "  timeshift_cam_imu: "
         << FormatYamlFloat(timing.time_offset_s - camera.timestamp_offset_s)
         << "\n"
@@ -308,7 +316,8 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
             "sigma), timing_source.\n";
     if (timed->timing->source == TimingSource::kMeasuredAfterCalibration) {
       yaml << "# Measured after a calibration that assumed synchronized "
-              "cameras: the time shifts are lower bounds.\n";
+              "cameras: the capture-time offsets are lower bounds in "
+              "magnitude.\n";
     }
   }
   std::vector<std::string> file_notes;

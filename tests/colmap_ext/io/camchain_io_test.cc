@@ -240,6 +240,12 @@ TEST(CamchainIo, CaptureTimingFieldsAreWrittenAndReadBack) {
   EXPECT_NE(text.find("the reference camera cam0 takes its place"),
             std::string::npos)
       << text;
+  EXPECT_NE(text.find("  # timeshift_cam_imu = the capture-time offset "
+                      "against the frameset times (0.0482 s) - the offset "
+                      "removed from the camera's names before grouping (0.03 "
+                      "s)"),
+            std::string::npos)
+      << text;
   const YAML::Node root = YAML::LoadFile(path);
   EXPECT_EQ(root["cam0"]["timeshift_cam_imu"].as<double>(), 0);
   EXPECT_NEAR(root["cam1"]["timeshift_cam_imu"].as<double>(), 0.0182, 1e-15);
