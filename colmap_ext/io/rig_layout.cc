@@ -588,6 +588,14 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
     layout->frameset_source = "identical names after the camera prefix";
   }
   if (!CheckCamerasConnected(image_names, keys, *layout, error)) {
+    // Timestamps with constant offsets between cameras pair once the
+    // offsets are removed.
+    if (options.frame_ids.empty() && options.timestamp_tolerance > 0 &&
+        !options.estimate_timestamp_offsets) {
+      *error +=
+          "; or, if the cameras' names differ by a constant, let "
+          "--RigCalibrator.timestamp_offsets auto remove it";
+    }
     *layout = RigLayout();
     return false;
   }

@@ -437,6 +437,14 @@ void FramesetsSection(const ModelResiduals& residuals,
   html << "</table></section>\n";
 }
 
+// Whether some camera of the summary has a "timing" (camera_timing.h).
+bool HasTiming(const ReportJson& summary) {
+  for (const ReportJson& camera : *FindKey(summary, "cameras")) {
+    if (FindKey(camera, "timing") != nullptr) return true;
+  }
+  return false;
+}
+
 // The cameras' capture timing (their "timing" in the summary,
 // camera_timing.h): the time offsets and, when estimated, the line delays;
 // nothing when no camera has a timing.
@@ -521,8 +529,9 @@ bool BuildReportHtml(const ReportInputs& inputs, std::string* html,
                  "href=\"#model-choice\">model choice</a><a "
                  "href=\"#diagnostics\">diagnostics</a><a "
                  "href=\"#cameras\">cameras</a><a href=\"#rig\">rig</a><a "
-                 "href=\"#framesets\">framesets</a><a "
-                 "href=\"#camchain\">camchain.yaml</a></nav>\n";
+                 "href=\"#framesets\">framesets</a>"
+              << (HasTiming(summary) ? "<a href=\"#timing\">timing</a>" : "")
+              << "<a href=\"#camchain\">camchain.yaml</a></nav>\n";
     OverviewSection(inputs, &page);
     page.html << "<section id=\"parameters\"><h2>Parameters</h2>\n"
               << IntrinsicsTableHtml(summary) << PosesTableHtml(summary)

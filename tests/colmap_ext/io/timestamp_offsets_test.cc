@@ -102,6 +102,9 @@ TEST(TimestampOffsets, ShiftedNamesGroupLikeUnshiftedOnes) {
   options.estimate_timestamp_offsets = false;
   EXPECT_FALSE(DiscoverRigLayout(shifted, options, &layout, &error));
   EXPECT_NE(error.find("never share a frameset"), std::string::npos) << error;
+  EXPECT_NE(error.find("let --RigCalibrator.timestamp_offsets auto remove it"),
+            std::string::npos)
+      << error;
 }
 
 // Random frameset times (periods of 40-60 ms), names with +-1 ms of jitter,

@@ -188,8 +188,9 @@ TEST(ReportPage, WithoutTheContractKeysSaysNotComputed) {
   // The summary writer's own word for an uncertainty it did not compute.
   EXPECT_NE(html.find("<th>uncertainty method</th><td>not computed</td>"),
             std::string::npos);
-  // No camera has a timing: no timing section.
+  // No camera has a timing: no timing section, no link to it.
   EXPECT_EQ(html.find("id=\"timing\""), std::string::npos);
+  EXPECT_EQ(html.find("#timing"), std::string::npos);
   // 3 x (residuals, coverage, distortion) + 2 rig views + framesets.
   EXPECT_NE(html.find("data-expected-figures=\"12\""), std::string::npos);
   // The diagnostics of the summary, by level.
@@ -230,7 +231,8 @@ TEST(ReportPage, TheContractKeysFillEverySection) {
         "<ellipse ", "Gauss-Newton covariance",
         "<li class=\"error\"><b>error</b> invalid_camera_model: cam1",
         "a diagnostic &lt;with&gt; markup &amp; quotes &quot;",
-        "<section id=\"timing\">", "<svg id=\"time-offsets\"",
+        "<section id=\"timing\">", "<a href=\"#timing\">timing</a>",
+        "<svg id=\"time-offsets\"",
         "<svg id=\"line-delays\"",
         "<text class=\"value\" x=\"480\" y=\"58.0\">+12.30 \u00b1 0.40 ms</text>",
         "+29.00 \u00b1 0.40 us/row</text>",
