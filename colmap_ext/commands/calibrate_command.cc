@@ -100,9 +100,12 @@ int RunCalibrate(int argc, char** argv) {
     PrintDiagnostics(report);
     return PrintError("calibration failed: " + report.error);
   }
-  const CalibrationSummary summary =
+  CalibrationSummary summary =
       MakeCalibrationSummary(dataset, calibration, layout.camera_prefixes,
                              report, pipeline.seed, known_rig);
+  for (const double offset : layout.timestamp_offsets) {
+    summary.timestamp_offsets_s.push_back(offset * options.timestamp_unit_s);
+  }
   std::vector<std::string> notes;
   if (!WriteRigOutput(options.output_path, map, dataset, calibration,
                       layout.camera_prefixes, summary,

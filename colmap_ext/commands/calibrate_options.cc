@@ -63,6 +63,12 @@ void AddRigCalibratorOptions(po::options_description* description,
             "seconds per unit of the numeric names (1e-9: nanoseconds); "
             "with timestamp_tolerance > 0 they give the frameset times of "
             "the capture-time offsets");
+  AddOption(description, "RigCalibrator.timestamp_offsets",
+            &o->timestamp_offsets,
+            "auto: remove each camera's constant timestamp offset against "
+            "the reference camera (estimated from the names: the offset "
+            "pairing most images within timestamp_tolerance) before "
+            "grouping; 0: group the names as they are");
   AddUnsetOption(description, "RigCalibrator.intrinsics_path",
                  &o->intrinsics_path,
                  "known intrinsics for the known* methods (rig_config.json "

@@ -30,6 +30,9 @@ struct CalibrateOptions {
   // Seconds per unit of the numeric names (the frameset times of the
   // capture-time offsets, capture_timing.h).
   double timestamp_unit_s = 1e-9;
+  // "auto": remove each camera's constant timestamp offset, estimated from
+  // the names, before grouping (timestamp_offsets.h); "0": none.
+  std::string timestamp_offsets = "auto";
   std::string intrinsics_path;
   // COLMAP's refinement switches, "1"/"0" or per camera "cam0:0,cam1:1"
   // (intrinsics_refinement_input.h).

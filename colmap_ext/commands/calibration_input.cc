@@ -127,6 +127,14 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
                  const RigLayoutOptions& frames = RigLayoutOptions()) {
   RigLayoutOptions layout_options = frames;
   layout_options.timestamp_tolerance = options.timestamp_tolerance;
+  layout_options.reference_camera = options.reference_camera;
+  if (options.timestamp_offsets != "auto" && options.timestamp_offsets != "0") {
+    *error = "--RigCalibrator.timestamp_offsets must be auto or 0, not '" +
+             options.timestamp_offsets + "'";
+    return false;
+  }
+  layout_options.estimate_timestamp_offsets =
+      options.timestamp_offsets == "auto";
   if (!(options.timestamp_unit_s > 0) ||
       !std::isfinite(options.timestamp_unit_s)) {
     *error = "--RigCalibrator.timestamp_unit_s must be a finite number > 0";
@@ -180,19 +188,7 @@ bool MakeDataset(const CalibrateOptions& options, const std::string& source,
     dataset->cameras.push_back(camera);
   }
   dataset->frameset_names = layout->frameset_names;
-  dataset->reference_camera = 0;
-  if (!options.reference_camera.empty()) {
-    const auto it =
-        std::find(layout->camera_names.begin(), layout->camera_names.end(),
-                  options.reference_camera);
-    if (it == layout->camera_names.end()) {
-      *error = "--RigCalibrator.reference_camera " + options.reference_camera +
-               " is not a camera of the rig";
-      return false;
-    }
-    dataset->reference_camera =
-        static_cast<int>(it - layout->camera_names.begin());
-  }
+  dataset->reference_camera = layout->reference_camera;
   for (size_t i = 0; i < image_names.size(); ++i) {
     if (layout->images[i].camera_index < 0) continue;
     RigImage image;

@@ -41,6 +41,11 @@ CalibrationSummary MakeCalibrationSummary(
   summary.seed = seed;
   summary.uncertainty = report.uncertainty;
   summary.capture_timing = report.capture_timing;
+  const std::vector<std::optional<CameraTiming>> timings =
+      MeasuredCameraTimings(report.capture_timing, dataset.reference_camera);
+  for (size_t c = 0; c < timings.size() && c < summary.cameras.size(); ++c) {
+    summary.cameras[c].timing = timings[c];
+  }
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);
@@ -77,7 +82,9 @@ void PrintResult(const RigDataset& dataset, const PipelineReport& report,
               << std::setprecision(4) << center.x() << ", " << center.y()
               << ", " << center.z() << ") images " << camera.num_used << "/"
               << camera.num_images << " RMS " << std::setprecision(3)
-              << camera.rms_px << " px\n";
+              << camera.rms_px << " px"
+              << (camera.timing ? " " + CameraTimingText(*camera.timing) : "")
+              << "\n";
   }
   for (const std::string& line : UncertaintyLines(
            CameraNames(summary), CameraModels(summary), summary.uncertainty)) {

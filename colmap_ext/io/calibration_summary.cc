@@ -1,5 +1,6 @@
 #include "colmap_ext/io/calibration_summary.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -94,6 +95,22 @@ Json CaptureTimingJson(const CalibrationSummary& summary) {
   return node;
 }
 
+// The camera's "timing" (CameraTiming): {"time_offset_s",
+// "time_offset_sigma_s", "line_delay_s_per_row" and
+// "line_delay_sigma_s_per_row" (both only when estimated), "source"}.
+Json CameraTimingJson(const CameraTiming& timing) {
+  Json node;
+  node["time_offset_s"] = JsonNumber(timing.time_offset_s);
+  node["time_offset_sigma_s"] = JsonNumber(timing.time_offset_sigma_s);
+  if (timing.line_delay_s_per_row) {
+    node["line_delay_s_per_row"] = JsonNumber(*timing.line_delay_s_per_row);
+    node["line_delay_sigma_s_per_row"] =
+        JsonNumber(timing.line_delay_sigma_s_per_row);
+  }
+  node["source"] = TimingSourceName(timing.source);
+  return node;
+}
+
 bool WriteJson(const std::string& path, const Json& root, std::string* error) {
   return WriteFileAtomically(
       path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
@@ -178,12 +195,28 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     node["rms_px"] = JsonNumber(camera.rms_px);
     AddCameraModelJson(camera.camera_model, &node);
     AddCoverageJson(camera, &node);
+    if (camera.timing) node["timing"] = CameraTimingJson(*camera.timing);
     cameras.push_back(node);
   }
   root["cameras"] = cameras;
   AddUncertaintyJson(summary.uncertainty, &root);
   if (summary.capture_timing.computed) {
     root["capture_time_offsets"] = CaptureTimingJson(summary);
+  }
+  if (std::any_of(summary.timestamp_offsets_s.begin(),
+                  summary.timestamp_offsets_s.end(),
+                  [](double offset) { return offset != 0; })) {
+    // {"reference_camera", "offsets_s": {camera: its names minus the
+    // reference camera's, seconds}}.
+    Json offsets = Json::object();
+    for (size_t c = 0; c < summary.cameras.size() &&
+                       c < summary.timestamp_offsets_s.size();
+         ++c) {
+      offsets[summary.cameras[c].name] =
+          JsonNumber(summary.timestamp_offsets_s[c]);
+    }
+    root["timestamp_offsets"] = {{"reference_camera", summary.reference_camera},
+                                 {"offsets_s", offsets}};
   }
   if (summary.known_rig_source.empty()) {
     root["known_rig"] = nullptr;

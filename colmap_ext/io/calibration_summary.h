@@ -16,6 +16,7 @@
 
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/camera_timing.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
@@ -44,6 +45,9 @@ struct CameraSummary {
   // estimated (PipelineReport::coverage, refined_intrinsics; coverage_json.h).
   std::optional<ImageCoverage> coverage;
   std::optional<IntrinsicsRefinement> refined;
+  // The capture timing (camera_timing.h), when some step produced one;
+  // written as the camera's "timing" only then.
+  std::optional<CameraTiming> timing;
 };
 
 // Known cam_from_rig of the rig cameras, e.g. the sensor_from_rig of a
@@ -102,6 +106,12 @@ struct CalibrationSummary {
   // The capture-time offsets (PipelineReport::capture_timing); written as
   // "capture_time_offsets" only when computed.
   CaptureTiming capture_timing;
+  // Per camera the constant removed from its numeric names before they were
+  // grouped into framesets (rig_layout.h, timestamp_offsets.h), in seconds;
+  // empty when the framesets did not come from timestamps. Written as
+  // "timestamp_offsets" only when one is not 0, so that names without
+  // offsets give the summary they gave before.
+  std::vector<double> timestamp_offsets_s;
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "colmap_ext/io/atomic_output.h"
@@ -178,6 +179,31 @@ const DistortionMapping kDistortionMappings[] = {
     {"THIN_PRISM_FISHEYE", "equidistant", {4, 5, 8, 9}, {6, 7, 10, 11}},
 };
 
+// The timing fields of a camera (see the header).
+void WriteTiming(const RigDescriptionCamera& camera, std::ostringstream* yaml) {
+  const CameraTiming& timing = *camera.timing;
+  if (camera.timestamp_offset_s != 0) {
+    *yaml << "  # timeshift_cam_imu = the capture-time offset against the "
+             "frameset times ("
+          << FormatYamlFloat(timing.time_offset_s)
+          << " s) - the offset removed from the camera's names before "
+             "grouping ("
+          << FormatYamlFloat(camera.timestamp_offset_s) << " s)\n";
+  }
+  *yaml << "  timeshift_cam_imu: "
+        << FormatYamlFloat(timing.time_offset_s - camera.timestamp_offset_s)
+        << "\n"
+        << "  timeshift_cam_imu_sigma: "
+        << FormatYamlFloat(timing.time_offset_sigma_s) << "\n";
+  if (timing.line_delay_s_per_row) {
+    *yaml << "  line_delay: " << FormatYamlFloat(*timing.line_delay_s_per_row)
+          << "\n"
+          << "  line_delay_sigma: "
+          << FormatYamlFloat(timing.line_delay_sigma_s_per_row) << "\n";
+  }
+  *yaml << "  timing_source: " << TimingSourceName(timing.source) << "\n";
+}
+
 }  // namespace
 
 bool ColmapToKalibrCamera(const colmap::Camera& camera, KalibrCamera* kalibr,
@@ -274,6 +300,26 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
        << "# Pixels: Kalibr convention, the center of the top-left pixel is "
           "(0, 0) (COLMAP's principal point minus 0.5).\n"
        << "# T_cn_cnm1 is cam_n_from_cam_(n-1): x_n = R x_(n-1) + t.\n";
+  const auto timed = std::find_if(
+      rig.cameras.begin(), rig.cameras.end(),
+      [](const RigDescriptionCamera& camera) {
+        return camera.timing.has_value() && camera.camera && camera.cam_from_rig;
+      });
+  if (timed != rig.cameras.end()) {
+    yaml << "# timeshift_cam_imu (s): no IMU here, the reference camera "
+         << rig.cameras[rig.reference_camera].name
+         << " takes its place: t_ref = t_cam + timeshift_cam_imu, t_cam the "
+            "camera's image timestamp, t_ref the reference camera's clock "
+            "when the image was taken.\n"
+         << "# line_delay (s/row): row v is taken at t_ref + line_delay * v. "
+            "Not Kalibr's: timeshift_cam_imu_sigma, line_delay_sigma (1 "
+            "sigma), timing_source.\n";
+    if (timed->timing->source == TimingSource::kMeasuredAfterCalibration) {
+      yaml << "# Measured after a calibration that assumed synchronized "
+              "cameras: the capture-time offsets are lower bounds in "
+              "magnitude.\n";
+    }
+  }
   std::vector<std::string> file_notes;
   const Rigid3d* previous_cam_from_rig = nullptr;
   int index = 0;
@@ -332,6 +378,7 @@ bool WriteCamchainYaml(const std::string& path, const RigDescription& rig,
          << "\n"
          << "  resolution: [" << kalibr.width << ", " << kalibr.height << "]\n"
          << "  rostopic: " << TopicPlaceholder(camera.name) << "\n";
+    if (camera.timing) WriteTiming(camera, &yaml);
     previous_cam_from_rig = &*camera.cam_from_rig;
     ++index;
   }
@@ -390,6 +437,73 @@ bool ReadCamchainCamera(const YAML::Node& node, const std::string& where,
   if (!KalibrToColmapCamera(kalibr, camera, &camera_error)) {
     *error = where + ": " + camera_error;
     return false;
+  }
+  return true;
+}
+
+// A finite number at `key` of `node`, if the key is there; false with an
+// error naming it otherwise.
+bool ReadOptionalNumber(const YAML::Node& node, const char* key,
+                        const std::string& where, std::optional<double>* value,
+                        std::string* error) {
+  const YAML::Node element = node[key];
+  value->reset();
+  if (!element) return true;
+  double number = 0;
+  if (!element.IsScalar() || !YAML::convert<double>::decode(element, number) ||
+      !std::isfinite(number)) {
+    *error = where + ": " + key + " must be a finite number";
+    return false;
+  }
+  *value = number;
+  return true;
+}
+
+// The timing fields of a camchain entry (see the header), if any.
+bool ReadCamchainTiming(const YAML::Node& node, const std::string& where,
+                        std::optional<CameraTiming>* timing,
+                        std::string* error) {
+  std::optional<double> shift, shift_sigma, line_delay, line_delay_sigma;
+  if (!ReadOptionalNumber(node, "timeshift_cam_imu", where, &shift, error) ||
+      !ReadOptionalNumber(node, "timeshift_cam_imu_sigma", where, &shift_sigma,
+                          error) ||
+      !ReadOptionalNumber(node, "line_delay", where, &line_delay, error) ||
+      !ReadOptionalNumber(node, "line_delay_sigma", where, &line_delay_sigma,
+                          error)) {
+    return false;
+  }
+  const YAML::Node source_node = node["timing_source"];
+  timing->reset();
+  if (!shift && !line_delay) {
+    if (shift_sigma || line_delay_sigma || source_node) {
+      *error = where +
+               ": timeshift_cam_imu_sigma, line_delay_sigma or timing_source "
+               "without timeshift_cam_imu or line_delay";
+      return false;
+    }
+    return true;
+  }
+  if ((shift_sigma && !shift) || (line_delay_sigma && !line_delay)) {
+    *error = where + ": a timing sigma without its value";
+    return false;
+  }
+  CameraTiming& read = timing->emplace();
+  read.time_offset_s = shift.value_or(0);
+  read.time_offset_sigma_s = shift_sigma.value_or(0);
+  read.line_delay_s_per_row = line_delay;
+  read.line_delay_sigma_s_per_row = line_delay_sigma.value_or(0);
+  if (source_node) {
+    const std::optional<TimingSource> source =
+        source_node.IsScalar()
+            ? TimingSourceFromName(source_node.Scalar())
+            : std::nullopt;
+    if (!source) {
+      *error = where +
+               ": timing_source must be \"measured after calibration\" or "
+               "\"estimated in the adjustment\"";
+      return false;
+    }
+    read.source = *source;
   }
   return true;
 }
@@ -466,6 +580,9 @@ bool ReadCamchainYaml(const std::string& path, RigDescription* rig,
     rig_camera.name = key;
     rig_camera.camera = camera;
     rig_camera.cam_from_rig = cam_from_cam0;
+    if (!ReadCamchainTiming(node, where, &rig_camera.timing, error)) {
+      return false;
+    }
     rig->cameras.push_back(std::move(rig_camera));
   }
   if (rig->cameras.empty()) {

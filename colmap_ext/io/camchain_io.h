@@ -35,6 +35,28 @@
 // is written next to the camera in the file. Kalibr's omni, ds and eucm
 // models are never written (no COLMAP 3.8 model is one of them) and are
 // refused when read.
+//
+// Capture timing (camera_timing.h), written per camera only when estimated:
+//   timeshift_cam_imu: s       Kalibr's name and sign, t_imu = t_cam + shift,
+//                              with the reference camera in the IMU's place:
+//                              t_ref = t_cam + timeshift_cam_imu, t_cam the
+//                              camera's own image timestamp, t_ref the time
+//                              on the reference camera's clock at which the
+//                              image was taken (0 for the reference camera);
+//                              = delta_c - the constant removed from the
+//                              camera's names to group them (seconds)
+//   line_delay: s/row          Kalibr's rolling-shutter line delay (row v is
+//                              taken at t_ref + line_delay * v), only when
+//                              estimated
+// and three fields Kalibr has not (tools that read Kalibr ignore them):
+//   timeshift_cam_imu_sigma    standard deviation of timeshift_cam_imu, s
+//   line_delay_sigma           standard deviation of line_delay, s/row
+//   timing_source              "measured after calibration" (lower bounds of
+//                              the offsets, capture_timing.h) or "estimated
+//                              in the adjustment"
+// Read back into RigDescriptionCamera::timing (time offset =
+// timeshift_cam_imu, timestamp_offset_s 0); a sigma or source without its
+// value, or a value that is not a finite number, is refused.
 #pragma once
 
 #include <colmap/base/camera.h>

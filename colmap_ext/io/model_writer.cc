@@ -484,6 +484,15 @@ bool WriteRigOutputFiles(const std::string& folder, const RigDataset& dataset,
   std::string camchain_error;
   RigDescription commented_rig = rig;
   AddUncertaintyComments(summary.uncertainty, &commented_rig);
+  for (size_t c = 0; c < commented_rig.cameras.size() &&
+                     c < summary.cameras.size();
+       ++c) {
+    commented_rig.cameras[c].timing = summary.cameras[c].timing;
+    if (c < summary.timestamp_offsets_s.size()) {
+      commented_rig.cameras[c].timestamp_offset_s =
+          summary.timestamp_offsets_s[c];
+    }
+  }
   if (!WriteCamchainYaml(folder + "/" + kCamchainFile, commented_rig,
                          &contents->notes, &camchain_error)) {
     contents->notes.push_back(std::string(kCamchainFile) +

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "src/calibration/camera_timing.h"
 #include "src/geometry/rigid3d.h"
 #include "src/rig/rig_dataset.h"
 
@@ -28,6 +29,14 @@ struct RigDescriptionCamera {
   // Lines written as comments with the camera in the formats that allow
   // them (camchain.yaml), e.g. the uncertainty (uncertainty_json.h).
   std::vector<std::string> comments;
+  // The capture timing (camera_timing.h), when estimated: delta_c relative
+  // to the frameset times; and the constant removed from the camera's own
+  // numeric names before grouping them into framesets (seconds,
+  // timestamp_offsets.h), so that the camera's capture time on the
+  // reference camera's clock is its own timestamp + delta_c -
+  // timestamp_offset_s (camchain's timeshift_cam_imu).
+  std::optional<CameraTiming> timing;
+  double timestamp_offset_s = 0;
 };
 
 struct RigDescription {

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "colmap_ext/io/timestamp_offsets.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -332,13 +334,16 @@ bool GroupGivenFrames(const std::vector<std::string>& image_names,
 }
 
 // The framesets, each a list of input indices: the images with the same key,
-// or (timestamp_tolerance > 0) the clusters of close timestamps per folder.
-// With timestamps, also each image's time (RigLayout::image_times).
+// or (timestamp_tolerance > 0) the clusters of close timestamps per folder,
+// each camera's timestamp offset removed. With timestamps, also each image's
+// time and the offsets (RigLayout::image_times, timestamp_offsets).
 bool GroupFramesets(const std::vector<std::string>& image_names,
                     const std::vector<std::string>& keys,
                     const RigLayoutOptions& options, const RigLayout& layout,
                     std::vector<std::vector<int>>* framesets,
-                    std::vector<double>* image_times, std::string* error) {
+                    std::vector<double>* image_times,
+                    std::vector<double>* timestamp_offsets,
+                    std::string* error) {
   if (!options.frame_ids.empty()) {
     return GroupGivenFrames(image_names, keys, options, layout, framesets,
                             error);
@@ -356,6 +361,29 @@ bool GroupFramesets(const std::vector<std::string>& image_names,
         return false;
       }
       folder_images[timed_keys[i].folder].push_back(static_cast<int>(i));
+    }
+    // Each camera's offset removed from its names (timestamp_offsets.h).
+    std::map<std::string, int> folder_ids;
+    std::vector<TimedName> names;
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index < 0) continue;
+      const auto folder = folder_ids.emplace(timed_keys[i].folder,
+                                             static_cast<int>(folder_ids.size()));
+      names.push_back({layout.images[i].camera_index, folder.first->second,
+                       timed_keys[i].time});
+    }
+    const int num_cameras = static_cast<int>(layout.camera_names.size());
+    const std::vector<long double> offsets =
+        options.estimate_timestamp_offsets
+            ? EstimateTimestampOffsets(names, num_cameras,
+                                       layout.reference_camera,
+                                       options.timestamp_tolerance)
+            : std::vector<long double>(num_cameras, 0);
+    timestamp_offsets->assign(offsets.begin(), offsets.end());
+    for (size_t i = 0; i < image_names.size(); ++i) {
+      if (layout.images[i].camera_index >= 0) {
+        timed_keys[i].time -= offsets[layout.images[i].camera_index];
+      }
     }
     // Relative to the earliest name, so that the differences of 19-digit
     // nanosecond stamps keep their precision as doubles.
@@ -395,6 +423,23 @@ bool GroupFramesets(const std::vector<std::string>& image_names,
       framesets->push_back(key_images[key]);
     }
   }
+  return true;
+}
+
+// The index of options.reference_camera (default: the first camera).
+bool FindReferenceCamera(const RigLayoutOptions& options, RigLayout* layout,
+                         std::string* error) {
+  layout->reference_camera = 0;
+  if (options.reference_camera.empty()) return true;
+  const auto it = std::find(layout->camera_names.begin(),
+                            layout->camera_names.end(),
+                            options.reference_camera);
+  if (it == layout->camera_names.end()) {
+    *error = "--RigCalibrator.reference_camera " + options.reference_camera +
+             " is not a camera of the rig";
+    return false;
+  }
+  layout->reference_camera = static_cast<int>(it - layout->camera_names.begin());
   return true;
 }
 
@@ -520,8 +565,10 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
   std::vector<std::vector<int>> framesets;
   if (!CameraPrefixes(image_names, options, &prefixes, error) ||
       !AssignCameras(image_names, prefixes, layout, &keys, error) ||
+      !FindReferenceCamera(options, layout, error) ||
       !GroupFramesets(image_names, keys, options, *layout, &framesets,
-                      &layout->image_times, error)) {
+                      &layout->image_times, &layout->timestamp_offsets,
+                      error)) {
     return false;
   }
   NameFramesets(keys, framesets, layout);
@@ -531,11 +578,24 @@ bool DiscoverRigLayout(const std::vector<std::string>& image_names,
     std::ostringstream source;
     source << "numeric names (timestamps) within "
            << options.timestamp_tolerance;
+    if (std::any_of(layout->timestamp_offsets.begin(),
+                    layout->timestamp_offsets.end(),
+                    [](double offset) { return offset != 0; })) {
+      source << " after removing each camera's timestamp offset";
+    }
     layout->frameset_source = source.str();
   } else {
     layout->frameset_source = "identical names after the camera prefix";
   }
   if (!CheckCamerasConnected(image_names, keys, *layout, error)) {
+    // Timestamps with constant offsets between cameras pair once the
+    // offsets are removed.
+    if (options.frame_ids.empty() && options.timestamp_tolerance > 0 &&
+        !options.estimate_timestamp_offsets) {
+      *error +=
+          "; or, if the cameras' names differ by a constant, let "
+          "--RigCalibrator.timestamp_offsets auto remove it";
+    }
     *layout = RigLayout();
     return false;
   }
@@ -600,6 +660,19 @@ std::string RigLayoutTable(const std::vector<std::string>& image_names,
     }
     table << (indices.size() > kMaxListed ? " ...\n" : "\n");
   };
+  if (std::any_of(layout.timestamp_offsets.begin(),
+                  layout.timestamp_offsets.end(),
+                  [](double offset) { return offset != 0; })) {
+    table << "  timestamp offsets removed before grouping (names minus "
+          << layout.camera_names[layout.reference_camera]
+          << "'s, names' units):";
+    table.precision(12);
+    for (int c = 0; c < num_cameras; ++c) {
+      table << " " << layout.camera_names[c] << " " << std::showpos
+            << layout.timestamp_offsets[c] << std::noshowpos
+            << (c + 1 < num_cameras ? "," : "\n");
+    }
+  }
   list("unmatched images (alone in their frameset)", layout.unmatched_images);
   list("ignored images (in no camera)", layout.ignored_images);
   return table.str();

@@ -27,6 +27,14 @@ struct RigLayoutOptions {
   // numbers are within this tolerance (in the names' units, e.g. nanoseconds)
   // form a frameset, at most one image per camera.
   double timestamp_tolerance = 0;
+  // With timestamp_tolerance > 0: remove each camera's constant offset from
+  // its names before grouping them (timestamp_offsets.h), so that cameras
+  // whose names differ by more than the tolerance still pair. Offsets of
+  // about 0 keep the grouping without them exactly.
+  bool estimate_timestamp_offsets = true;
+  // The reference camera's name (the offsets are relative to it); empty:
+  // the first camera.
+  std::string reference_camera;
   // Empty, or one per image name: the id of the frame the image is in (e.g.
   // COLMAP's frames/frame_data), -1 for none. Given, the framesets are these
   // frames (an image without one is alone) and timestamp_tolerance is not
@@ -61,17 +69,24 @@ struct RigLayout {
   // the camera prefix", "timestamps within ...", or the given frame_source.
   std::string frameset_source;
   // With timestamp_tolerance > 0 (and no given frames): per input image its
-  // number minus the smallest one (in the names' units; -1 for an ignored
-  // image), else empty.
+  // number minus its camera's timestamp offset (below) minus the smallest
+  // such number, i.e. on the reference camera's clock (in the names' units;
+  // -1 for an ignored image), else empty.
   std::vector<double> image_times;
+  // With timestamp_tolerance > 0: per camera the constant removed from its
+  // names before grouping (its names minus the reference camera's, names'
+  // units; all 0 without estimate_timestamp_offsets), else empty.
+  std::vector<double> timestamp_offsets;
+  int reference_camera = 0;  // index of RigLayoutOptions::reference_camera
 };
 
 // Discovers the cameras and framesets of `image_names` (the rig images only,
 // not the map's). Fails with a message in `error` when there are no camera
 // folders, fewer than two cameras, a given prefix matches no image, numeric
 // keys are expected but a name is not a number, a given frame holds two
-// images of one camera, or some cameras never share a frameset (directly or
-// through other cameras) with the others.
+// images of one camera, the reference camera is not a camera, or some
+// cameras never share a frameset (directly or through other cameras) with
+// the others.
 bool DiscoverRigLayout(const std::vector<std::string>& image_names,
                        const RigLayoutOptions& options, RigLayout* layout,
                        std::string* error);
@@ -85,7 +100,8 @@ std::string RigLayoutTable(const std::vector<std::string>& image_names,
 
 // The frameset times (RigDataset::frameset_times_s) of a layout with
 // image_times: per frameset the time of its `reference_camera` image, or the
-// median of its images' times when that camera is not in it, times
+// median of its images' times (timestamp offsets removed: on the reference
+// camera's clock) when that camera is not in it, times
 // `unit_s` (seconds per name unit, e.g. 1e-9 for nanosecond names); origin
 // the earliest image. Empty when the layout has no times or the frameset
 // times are not strictly increasing (e.g. framesets of several subfolders,

@@ -10,6 +10,7 @@
 
 #include "colmap_ext/io/atomic_output.h"
 #include "colmap_ext/io/model_writer.h"
+#include "colmap_ext/report/capture_timing_figure.h"
 #include "colmap_ext/report/distortion_profile_figure.h"
 #include "colmap_ext/report/frameset_errors_figure.h"
 #include "colmap_ext/report/heat_map_figure.h"
@@ -436,6 +437,70 @@ void FramesetsSection(const ModelResiduals& residuals,
   html << "</table></section>\n";
 }
 
+// Whether some camera of the summary has a "timing" (camera_timing.h).
+bool HasTiming(const ReportJson& summary) {
+  for (const ReportJson& camera : *FindKey(summary, "cameras")) {
+    if (FindKey(camera, "timing") != nullptr) return true;
+  }
+  return false;
+}
+
+// The cameras' capture timing (their "timing" in the summary,
+// camera_timing.h): the time offsets and, when estimated, the line delays;
+// nothing when no camera has a timing.
+void TimingSection(const ReportJson& summary, Page* page) {
+  std::vector<TimingFigurePoint> offsets, line_delays;
+  std::string source;
+  for (const ReportJson& camera : *FindKey(summary, "cameras")) {
+    const ReportJson* timing = FindKey(camera, "timing");
+    if (timing == nullptr) continue;
+    const std::string name = TextAt(camera, "name");
+    source = TextAt(*timing, "source");
+    offsets.push_back({name, NumberAt(*timing, "time_offset_s") * 1e3,
+                       NumberAt(*timing, "time_offset_sigma_s") * 1e3});
+    if (FindKey(*timing, "line_delay_s_per_row") != nullptr) {
+      line_delays.push_back(
+          {name, NumberAt(*timing, "line_delay_s_per_row") * 1e6,
+           NumberAt(*timing, "line_delay_sigma_s_per_row") * 1e6});
+    }
+  }
+  if (offsets.empty()) return;
+  const std::string reference = TextAt(summary, "reference_camera");
+  const bool measured_after = source == "measured after calibration";
+  std::ostringstream& html = page->html;
+  html << "<section id=\"timing\"><h2>Capture timing</h2><div "
+          "class=\"figures\">\n";
+  page->Figure(
+      "time-offsets",
+      CaptureTimingSvg("time-offsets", "Capture-time offset per camera", "ms",
+                       offsets),
+      XmlEscape(
+          "Each camera's capture-time offset δ against " + reference +
+          ": it takes frameset f at t_f + δ, t_f on " + reference +
+          "'s clock (" + reference +
+          ": 0 by definition). Dot: the estimate; thick bar: ±1 "
+          "σ; thin bar: ±3 σ. " +
+          (measured_after
+               ? "Measured after the calibration from each image's own pose "
+                 "(" + source +
+                     "): the calibration assumed synchronized cameras and its "
+                     "intrinsics absorbed part of the rig's motion, so the "
+                     "offsets are lower bounds of the true ones."
+               : "Source: " + source + ".")));
+  if (!line_delays.empty()) {
+    page->Figure(
+        "line-delays",
+        CaptureTimingSvg("line-delays", "Rolling-shutter line delay per camera",
+                         "us/row", line_delays),
+        XmlEscape("Each camera's line delay ρ: image row v is taken at "
+                  "t_f + δ + ρ v (µs per row; 0: a global "
+                  "shutter). Bars: ±1 σ and ±3 σ. "
+                  "Source: " +
+                  source + "."));
+  }
+  html << "</div></section>\n";
+}
+
 }  // namespace
 
 bool BuildReportHtml(const ReportInputs& inputs, std::string* html,
@@ -464,8 +529,9 @@ bool BuildReportHtml(const ReportInputs& inputs, std::string* html,
                  "href=\"#model-choice\">model choice</a><a "
                  "href=\"#diagnostics\">diagnostics</a><a "
                  "href=\"#cameras\">cameras</a><a href=\"#rig\">rig</a><a "
-                 "href=\"#framesets\">framesets</a><a "
-                 "href=\"#camchain\">camchain.yaml</a></nav>\n";
+                 "href=\"#framesets\">framesets</a>"
+              << (HasTiming(summary) ? "<a href=\"#timing\">timing</a>" : "")
+              << "<a href=\"#camchain\">camchain.yaml</a></nav>\n";
     OverviewSection(inputs, &page);
     page.html << "<section id=\"parameters\"><h2>Parameters</h2>\n"
               << IntrinsicsTableHtml(summary) << PosesTableHtml(summary)
@@ -486,6 +552,7 @@ bool BuildReportHtml(const ReportInputs& inputs, std::string* html,
     page.html << "</section>\n";
     RigSection(summary, &page);
     FramesetsSection(residuals, camera_names, &page);
+    TimingSection(summary, &page);
     page.html << "<section id=\"camchain\"><h2>camchain.yaml</h2>\n";
     if (inputs.camchain_yaml.empty()) {
       page.html << "<p>" << NotComputedHtml("no camchain.yaml in the folder")

@@ -84,9 +84,9 @@ expect_failure "$WORK/apart_out" \
 [ "$(sums "$WORK/apart")" = "$before" ] || fail "camera apart: input changed"
 echo "camera never in a frameset: $(grep ERROR "$WORK/apart_out.log" | cut -c1-160)…"
 
-# 3. Timestamp names, cam1's 12 ms late: with a 5 ms tolerance nothing
-# pairs up (the message gives the tolerance that would), with 15 ms it
-# calibrates.
+# 3. Timestamp names, cam1's 12 ms late: with a 5 ms tolerance and no
+# timestamp offsets nothing pairs up (the message gives the tolerance that
+# would); with the offsets estimated (the default) or 15 ms it calibrates.
 synthetic timed --preset stereo_pair
 python3 - "$WORK/timed/correspondences.txt" <<'EOF'
 import re, sys
@@ -99,12 +99,26 @@ text = re.sub(r"^IMAGE (cam\d)/(\d+)\.png", timestamp, open(path).read(), flags=
 open(path, "w").write(text)
 EOF
 before=$(sums "$WORK/timed")
-calibrate "$WORK/timed" "$WORK/timed_out" --RigCalibrator.timestamp_tolerance 5e6
+calibrate "$WORK/timed" "$WORK/timed_out" --RigCalibrator.timestamp_tolerance 5e6 \
+  --RigCalibrator.timestamp_offsets 0
 expect_failure "$WORK/timed_out" \
   "never share a frameset.*12000000 apart.*set --RigCalibrator.timestamp_tolerance to at least that" $?
 echo "timestamps 12 ms apart, tolerance 5 ms: $(grep -o 'The closest.*at least that' "$WORK/timed_out.log")"
 calibrate "$WORK/timed" "$WORK/timed_ok" --RigCalibrator.timestamp_tolerance 15e6 ||
   fail "timestamps with 15 ms tolerance: $(tail -3 "$WORK/timed_ok.log")"
+calibrate "$WORK/timed" "$WORK/timed_auto" --RigCalibrator.timestamp_tolerance 5e6 ||
+  fail "timestamps with their offset removed: $(tail -3 "$WORK/timed_auto.log")"
+grep -q "timestamp offsets removed before grouping (names minus cam0's, names' units): cam0 +0, cam1 +12000000" \
+  "$WORK/timed_auto.log" || fail "timestamps: the removed offset is not in the log"
+python3 - "$WORK/timed_auto/calibration_summary.json" <<'EOF' ||
+import json, sys
+offsets = json.load(open(sys.argv[1]))["timestamp_offsets"]
+assert offsets["reference_camera"] == "cam0", offsets
+assert abs(offsets["offsets_s"]["cam1"] - 0.012) < 1e-12, offsets
+assert offsets["offsets_s"]["cam0"] == 0, offsets
+EOF
+  fail "timestamps: the removed offset is not in the summary"
+echo "timestamps 12 ms apart, tolerance 5 ms, offsets auto: $(grep -o 'timestamp offsets removed.*' "$WORK/timed_auto.log")"
 [ "$(sums "$WORK/timed")" = "$before" ] || fail "timestamps: input changed"
 
 # 4. The same rig with the map in millimetres: the same calibration up to
@@ -112,6 +126,15 @@ calibrate "$WORK/timed" "$WORK/timed_ok" --RigCalibrator.timestamp_tolerance 15e
 synthetic metres --preset ring5
 synthetic millimetres --preset ring5 --map_scale 1000
 calibrate "$WORK/metres" "$WORK/metres_out" || fail "metres: $(tail -3 "$WORK/metres_out.log")"
+# Without frameset times (names, not timestamps) no output mentions timing.
+! grep -qE '"(timing|timestamp_offsets|capture_time_offsets)"' "$WORK/metres_out/calibration_summary.json" ||
+  fail "metres: timing in the summary without frameset times"
+! grep -qE 'timeshift|line_delay|timing_source' "$WORK/metres_out/camchain.yaml" ||
+  fail "metres: timing in camchain.yaml without frameset times"
+! grep -qE 'id="timing"|time-offsets' "$WORK/metres_out/report.html" ||
+  fail "metres: timing in report.html without frameset times"
+! grep -qE ' dt [+-]|timestamp offsets' "$WORK/metres_out.log" ||
+  fail "metres: timing in the terminal without frameset times"
 calibrate "$WORK/millimetres" "$WORK/millimetres_out" ||
   fail "millimetres: $(tail -3 "$WORK/millimetres_out.log")"
 python3 - "$WORK/metres_out/calibration_summary.json" \

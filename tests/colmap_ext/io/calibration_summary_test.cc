@@ -151,5 +151,64 @@ TEST(CaptureTimeOffsetsJson, WrittenOnlyWhenComputed) {
   EXPECT_EQ(node["cameras"][1]["num_framesets_used"], 18);
 }
 
+// Each camera's "timing" (camera_timing.h) and the top-level
+// "timestamp_offsets" only when there are some (offsets not all 0): the offset and its sigma,
+// the line delay only when estimated, the source in words; the cameras
+// without keep their keys as before.
+TEST(CameraTimingJson, WrittenOnlyWhenPresent) {
+  CalibrationSummary summary;
+  summary.reference_camera = "cam0";
+  summary.cameras.resize(3);
+  for (int c = 0; c < 3; ++c) {
+    summary.cameras[c].name = "cam" + std::to_string(c);
+  }
+  testing::ScopedTempDir temp;
+  std::string error;
+  ASSERT_TRUE(
+      WriteCalibrationSummaryJson(temp.File("plain.json"), summary, &error))
+      << error;
+  const std::string plain = testing::ReadBytes(temp.File("plain.json"));
+  EXPECT_EQ(plain.find("timing"), std::string::npos);
+  EXPECT_EQ(plain.find("timestamp_offsets"), std::string::npos);
+  // Timestamp names whose offsets are all 0: the same bytes.
+  summary.timestamp_offsets_s = {0, 0, 0};
+  ASSERT_TRUE(
+      WriteCalibrationSummaryJson(temp.File("zero.json"), summary, &error))
+      << error;
+  EXPECT_EQ(testing::ReadBytes(temp.File("zero.json")), plain);
+
+  summary.cameras[0].timing.emplace();
+  CameraTiming& measured = summary.cameras[1].timing.emplace();
+  measured.time_offset_s = 0.0482;
+  measured.time_offset_sigma_s = 0.0003;
+  CameraTiming& estimated = summary.cameras[2].timing.emplace();
+  estimated.time_offset_s = -0.0125;
+  estimated.time_offset_sigma_s = 0.0001;
+  estimated.line_delay_s_per_row = 2.9e-5;
+  estimated.line_delay_sigma_s_per_row = 4e-7;
+  estimated.source = TimingSource::kEstimatedInAdjustment;
+  summary.timestamp_offsets_s = {0, 0.030, -0.012};
+  ASSERT_TRUE(
+      WriteCalibrationSummaryJson(temp.File("timed.json"), summary, &error))
+      << error;
+  std::ifstream file(temp.File("timed.json"));
+  const nlohmann::json root = nlohmann::json::parse(file);
+  const nlohmann::json& cam1 = root["cameras"][1]["timing"];
+  EXPECT_EQ(cam1["time_offset_s"].get<double>(), 0.0482);
+  EXPECT_EQ(cam1["time_offset_sigma_s"].get<double>(), 0.0003);
+  EXPECT_FALSE(cam1.contains("line_delay_s_per_row"));
+  EXPECT_EQ(cam1["source"], "measured after calibration");
+  const nlohmann::json& cam2 = root["cameras"][2]["timing"];
+  EXPECT_EQ(cam2["line_delay_s_per_row"].get<double>(), 2.9e-5);
+  EXPECT_EQ(cam2["line_delay_sigma_s_per_row"].get<double>(), 4e-7);
+  EXPECT_EQ(cam2["source"], "estimated in the adjustment");
+  EXPECT_EQ(root["cameras"][0]["timing"]["time_offset_s"].get<double>(), 0);
+  EXPECT_EQ(root["timestamp_offsets"]["reference_camera"], "cam0");
+  EXPECT_EQ(root["timestamp_offsets"]["offsets_s"]["cam1"].get<double>(),
+            0.030);
+  EXPECT_EQ(root["timestamp_offsets"]["offsets_s"]["cam2"].get<double>(),
+            -0.012);
+}
+
 }  // namespace calibration_summary_test
 }  // namespace rig_calibrator

@@ -193,6 +193,102 @@ TEST(CamchainIo, RoundTripThroughFile) {
   }
 }
 
+// The capture timing (camera_timing.h) in Kalibr's fields, with the sign
+// t_ref = t_cam + timeshift_cam_imu (the reference camera in the IMU's
+// place): delta_c minus the offset removed from the camera's names; the
+// line delay only when estimated; read back. Without a timing the file has
+// none of these fields or their comments.
+TEST(CamchainIo, CaptureTimingFieldsAreWrittenAndReadBack) {
+  RigDescription rig;
+  rig.cameras.resize(3);
+  for (int c = 0; c < 3; ++c) {
+    rig.cameras[c].name = "cam" + std::to_string(c);
+    rig.cameras[c].camera = MakeCamera("PINHOLE", {500, 500, 320, 240});
+    rig.cameras[c].cam_from_rig = Rigid3d();
+  }
+  testing::ScopedTempDir dir;
+  std::string error;
+  ASSERT_TRUE(WriteCamchainYaml(dir.File("untimed.yaml"), rig, nullptr, &error))
+      << error;
+  const std::string untimed = testing::ReadBytes(dir.File("untimed.yaml"));
+  for (const char* field : {"timeshift", "line_delay", "timing_source"}) {
+    EXPECT_EQ(untimed.find(field), std::string::npos) << field;
+  }
+  RigDescription read;
+  ASSERT_TRUE(ReadCamchainYaml(dir.File("untimed.yaml"), &read, &error))
+      << error;
+  EXPECT_FALSE(read.cameras[1].timing);
+
+  rig.cameras[0].timing.emplace();  // the reference: 0 by definition
+  CameraTiming& measured = rig.cameras[1].timing.emplace();
+  measured.time_offset_s = 0.0482;
+  measured.time_offset_sigma_s = 0.0003;
+  // Its names were 0.030 s late and that was removed before grouping: its
+  // own timestamps need +0.0182 s.
+  rig.cameras[1].timestamp_offset_s = 0.030;
+  CameraTiming& estimated = rig.cameras[2].timing.emplace();
+  estimated.time_offset_s = -0.0125;
+  estimated.time_offset_sigma_s = 0.0001;
+  estimated.line_delay_s_per_row = 2.9e-5;
+  estimated.line_delay_sigma_s_per_row = 4e-7;
+  estimated.source = TimingSource::kEstimatedInAdjustment;
+  const std::string path = dir.File("camchain.yaml");
+  ASSERT_TRUE(WriteCamchainYaml(path, rig, nullptr, &error)) << error;
+  const std::string text = testing::ReadBytes(path);
+  EXPECT_NE(text.find("t_ref = t_cam + timeshift_cam_imu"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("the reference camera cam0 takes its place"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  # timeshift_cam_imu = the capture-time offset "
+                      "against the frameset times (0.0482 s) - the offset "
+                      "removed from the camera's names before grouping (0.03 "
+                      "s)"),
+            std::string::npos)
+      << text;
+  const YAML::Node root = YAML::LoadFile(path);
+  EXPECT_EQ(root["cam0"]["timeshift_cam_imu"].as<double>(), 0);
+  EXPECT_NEAR(root["cam1"]["timeshift_cam_imu"].as<double>(), 0.0182, 1e-15);
+  EXPECT_EQ(root["cam1"]["timeshift_cam_imu_sigma"].as<double>(), 0.0003);
+  EXPECT_FALSE(root["cam1"]["line_delay"]);
+  EXPECT_EQ(root["cam1"]["timing_source"].as<std::string>(),
+            "measured after calibration");
+  EXPECT_EQ(root["cam2"]["line_delay"].as<double>(), 2.9e-5);
+  EXPECT_EQ(root["cam2"]["line_delay_sigma"].as<double>(), 4e-7);
+  EXPECT_EQ(root["cam2"]["timing_source"].as<std::string>(),
+            "estimated in the adjustment");
+
+  ASSERT_TRUE(ReadCamchainYaml(path, &read, &error)) << error;
+  ASSERT_EQ(read.cameras.size(), 3u);
+  ASSERT_TRUE(read.cameras[0].timing && read.cameras[1].timing &&
+              read.cameras[2].timing);
+  EXPECT_EQ(read.cameras[0].timing->time_offset_s, 0);
+  EXPECT_NEAR(read.cameras[1].timing->time_offset_s, 0.0182, 1e-15);
+  EXPECT_EQ(read.cameras[1].timestamp_offset_s, 0);
+  EXPECT_EQ(read.cameras[1].timing->time_offset_sigma_s, 0.0003);
+  EXPECT_FALSE(read.cameras[1].timing->line_delay_s_per_row);
+  EXPECT_EQ(read.cameras[1].timing->source,
+            TimingSource::kMeasuredAfterCalibration);
+  EXPECT_EQ(*read.cameras[2].timing->line_delay_s_per_row, 2.9e-5);
+  EXPECT_EQ(read.cameras[2].timing->line_delay_sigma_s_per_row, 4e-7);
+  EXPECT_EQ(read.cameras[2].timing->source,
+            TimingSource::kEstimatedInAdjustment);
+
+  // Malformed timing fields are refused, naming the file, camera and field.
+  const std::string bad = dir.File("bad.yaml");
+  for (const auto& [field, message] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"  timeshift_cam_imu: soon\n", "timeshift_cam_imu must be a finite"},
+           {"  timeshift_cam_imu_sigma: 0.1\n", "without timeshift_cam_imu"},
+           {"  line_delay: 1e-5\n  timing_source: guessed\n",
+            "timing_source must be"}}) {
+    std::ofstream(bad) << untimed << field;
+    EXPECT_FALSE(ReadCamchainYaml(bad, &read, &error)) << field;
+    EXPECT_NE(error.find(bad + ": cam2: "), std::string::npos) << error;
+    EXPECT_NE(error.find(message), std::string::npos) << error;
+  }
+}
+
 TEST(CamchainIo, ApproximationIsNotedInFile) {
   RigDescription rig;
   rig.cameras.resize(2);

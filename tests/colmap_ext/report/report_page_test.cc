@@ -188,6 +188,9 @@ TEST(ReportPage, WithoutTheContractKeysSaysNotComputed) {
   // The summary writer's own word for an uncertainty it did not compute.
   EXPECT_NE(html.find("<th>uncertainty method</th><td>not computed</td>"),
             std::string::npos);
+  // No camera has a timing: no timing section, no link to it.
+  EXPECT_EQ(html.find("id=\"timing\""), std::string::npos);
+  EXPECT_EQ(html.find("#timing"), std::string::npos);
   // 3 x (residuals, coverage, distortion) + 2 rig views + framesets.
   EXPECT_NE(html.find("data-expected-figures=\"12\""), std::string::npos);
   // The diagnostics of the summary, by level.
@@ -205,7 +208,8 @@ TEST(ReportPage, TheContractKeysFillEverySection) {
   testing::MergeContractKeys(output);
   const std::string html = BuildPage(output);
   EXPECT_EQ(html.find("not computed"), std::string::npos);
-  EXPECT_NE(html.find("data-expected-figures=\"15\""), std::string::npos);
+  // 15 + the time offsets and line delays of the cameras' "timing".
+  EXPECT_NE(html.find("data-expected-figures=\"17\""), std::string::npos);
   for (int c = 0; c < 3; ++c) {
     const std::string i = std::to_string(c);
     for (const std::string figure :
@@ -226,10 +230,46 @@ TEST(ReportPage, TheContractKeysFillEverySection) {
         "From &quot;coverage&quot;: 75 %", "median 0.31 px, max 0.9 px",
         "<ellipse ", "Gauss-Newton covariance",
         "<li class=\"error\"><b>error</b> invalid_camera_model: cam1",
-        "a diagnostic &lt;with&gt; markup &amp; quotes &quot;"}) {
+        "a diagnostic &lt;with&gt; markup &amp; quotes &quot;",
+        "<section id=\"timing\">", "<a href=\"#timing\">timing</a>",
+        "<svg id=\"time-offsets\"",
+        "<svg id=\"line-delays\"",
+        "<text class=\"value\" x=\"480\" y=\"58.0\">+12.30 \u00b1 0.40 ms</text>",
+        "+29.00 \u00b1 0.40 us/row</text>",
+        "Source: estimated in the adjustment."}) {
     EXPECT_NE(html.find(text), std::string::npos) << text;
   }
   EXPECT_EQ(Count(html, "<b class=\"chosen\">"), 3u);
+}
+
+// Offsets measured after the calibration (capture_timing.h): one figure,
+// the offsets with their sigma, the reference's 0, and a caption saying they
+// are lower bounds; no line-delay figure without line delays.
+TEST(ReportPage, MeasuredTimeOffsetsAreShownAsLowerBounds) {
+  const Scene scene = MakeScene();
+  ScopedTempDir dir;
+  const std::string output = dir.File("out");
+  std::string error;
+  ASSERT_TRUE(WriteSceneOutput(scene, output, false, &error)) << error;
+  const std::string path = output + "/" + kSummaryFile;
+  nlohmann::ordered_json summary = testing::ReadJsonFile(path);
+  summary["cameras"][0]["timing"] = {{"time_offset_s", 0.0},
+                                     {"time_offset_sigma_s", 0.0},
+                                     {"source", "measured after calibration"}};
+  summary["cameras"][2]["timing"] = {{"time_offset_s", -0.04815},
+                                     {"time_offset_sigma_s", 0.00031},
+                                     {"source", "measured after calibration"}};
+  std::ofstream(path) << summary.dump(2) << "\n";
+  const std::string html = BuildPage(output);
+  EXPECT_NE(html.find("<svg id=\"time-offsets\""), std::string::npos);
+  EXPECT_EQ(html.find("line-delays"), std::string::npos);
+  for (const char* text :
+       {">+0.00 \u00b1 0.00 ms</text>", ">-48.15 \u00b1 0.31 ms</text>",
+        "against cam0", "lower bounds of the true ones"}) {
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  }
+  EXPECT_EQ(Count(html, "<text class=\"value\""), 2u);
+  EXPECT_NE(html.find("data-expected-figures=\"13\""), std::string::npos);
 }
 
 TEST(ReportPage, IsWrittenInsideTheOutputAndRebuiltIdentically) {
