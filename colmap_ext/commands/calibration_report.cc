@@ -41,6 +41,7 @@ CalibrationSummary MakeCalibrationSummary(
   summary.seed = seed;
   summary.uncertainty = report.uncertainty;
   summary.capture_timing = report.capture_timing;
+  summary.capture_time_model = report.capture_time_model;
   for (const Diagnostic& diagnostic : report.diagnostics) {
     summary.diagnostics.push_back(DiagnosticLevelName(diagnostic.level) + " " +
                                   diagnostic.code + ": " + diagnostic.message);

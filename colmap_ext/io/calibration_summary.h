@@ -16,6 +16,7 @@
 
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/capture_time_model.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
@@ -102,6 +103,9 @@ struct CalibrationSummary {
   // The capture-time offsets (PipelineReport::capture_timing); written as
   // "capture_time_offsets" only when computed.
   CaptureTiming capture_timing;
+  // The final adjustment's time model (PipelineReport::capture_time_model);
+  // written as "capture_time_model" only when computed.
+  CaptureTimeModel capture_time_model;
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -110,6 +110,9 @@ bool CalibrateRig(const PipelineOptions& options, const RigDataset& dataset,
                                 "Final bundle adjustment, models changed")) {
     return false;
   }
+  if (!RunCaptureTimeModel(options, method, dataset, calibration, report)) {
+    return false;
+  }
   CheckCameraModels(options, dataset, *calibration, report);
   RunUncertaintyEstimation(options, method, dataset, *calibration, report);
   RunCaptureTiming(options, dataset, *calibration, report);
