@@ -24,10 +24,14 @@ double CalibrationRms(const RigCalibration& calibration) {
   return count > 0 ? std::sqrt(sum / count) : 0;
 }
 
-bool Significant(double value, double sigma, double min_sigmas,
-                 double min_value) {
-  return std::isfinite(sigma) && std::abs(value) > min_sigmas * sigma &&
-         std::abs(value) > min_value;
+// Beyond the floor and min_sigmas sigma; without a sigma (the covariance
+// failed), beyond the floor when the time model lowered the RMS by
+// min_rms_drop of it.
+bool Significant(double value, double sigma, double min_value,
+                 bool rms_dropped, const CaptureTimeModelOptions& options) {
+  if (!(std::abs(value) > min_value)) return false;
+  return std::isfinite(sigma) ? std::abs(value) > options.min_sigmas * sigma
+                              : rms_dropped;
 }
 
 // The start offsets: the capture-timing estimate of the observable cameras.
@@ -166,18 +170,21 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
   model->cameras = summary.capture_times;
   model->time_offset_significant.assign(num_cameras, false);
   model->line_delay_significant.assign(num_cameras, false);
+  const bool rms_dropped = summary.final_rms_px <
+                           (1 - options.min_rms_drop) * model->rms_without_px;
   bool any_offset = false, any_delay = false;
   for (size_t c = 0; c < num_cameras; ++c) {
     const CameraCaptureTime& time = model->cameras[c];
     model->time_offset_significant[c] =
         time.time_offset_estimated &&
         Significant(time.time_offset_s, time.time_offset_sigma_s,
-                    options.min_sigmas, options.min_offset_s);
+                    options.min_offset_s, rms_dropped, options);
     const double height = static_cast<double>(calibration->cameras[c].Height());
     model->line_delay_significant[c] =
         time.line_delay_estimated &&
-        Significant(time.line_delay_s * height, time.line_delay_sigma_s * height,
-                    options.min_sigmas, options.min_readout_s);
+        Significant(time.line_delay_s * height,
+                    time.line_delay_sigma_s * height, options.min_readout_s,
+                    rms_dropped, options);
     any_offset = any_offset || model->time_offset_significant[c];
     any_delay = any_delay || model->line_delay_significant[c];
   }
