@@ -133,6 +133,15 @@ void AddRigCalibratorOptions(po::options_description* description,
             "Levenberg-Marquardt) or ceres (Ceres', the reference it is "
             "compared with: the same minimum, slower, and not bit-identical "
             "across thread counts)");
+  AddOption(description, "RigCalibrator.time_offsets", &o->time_offsets,
+            "per-camera capture-time offsets in the final adjustment (needs "
+            "frameset times): 1 estimate, 0 not, auto estimate and keep when "
+            "significant (> 3 sigma and > 1 ms)");
+  AddOption(description, "RigCalibrator.rolling_shutter",
+            &o->rolling_shutter,
+            "per-camera rolling-shutter line delays in the final adjustment "
+            "(needs frameset times): 1, 0 or auto (kept when the readout "
+            "time is > 3 sigma and > 1 ms)");
 }
 
 void AddLocalizationOptions(po::options_description* description,
@@ -235,6 +244,16 @@ bool MakePipelineOptions(CalibrateOptions* options, PipelineOptions* pipeline,
     return false;
   }
   pipeline->radial_bundle_adjustment.bundle_solver = bundle_solver;
+  if (!CaptureTimeModeFromName(options->time_offsets,
+                               &pipeline->capture_time_model.time_offsets) ||
+      !CaptureTimeModeFromName(options->rolling_shutter,
+                               &pipeline->capture_time_model.rolling_shutter)) {
+    *error =
+        "--RigCalibrator.time_offsets and rolling_shutter must be auto, 0 or "
+        "1, not " +
+        options->time_offsets + " / " + options->rolling_shutter;
+    return false;
+  }
   pipeline->final_bundle_adjustment.bundle_solver = bundle_solver;
   pipeline->num_threads = options->num_threads;
   pipeline->seed = static_cast<unsigned int>(options->seed);

@@ -64,6 +64,10 @@ struct CalibrateOptions {
   int seed = 0;
   // The bundle adjustments' solver backend (bundle_solver.h): own or ceres.
   std::string bundle_solver = "own";
+  // The final adjustment's capture-time model (capture_time_model.h):
+  // auto, 0 or 1, for the offsets and the rolling shutter's line delays.
+  std::string time_offsets = "auto";
+  std::string rolling_shutter = "auto";
 
   std::string localization_mode = "direct";
   std::string vocab_tree_path;

@@ -41,8 +41,15 @@ CalibrationSummary MakeCalibrationSummary(
   summary.seed = seed;
   summary.uncertainty = report.uncertainty;
   summary.capture_timing = report.capture_timing;
-  const std::vector<std::optional<CameraTiming>> timings =
-      MeasuredCameraTimings(report.capture_timing, dataset.reference_camera);
+  summary.capture_time_model = report.capture_time_model;
+  // The adjustment's timing when it modelled time, else the measurement
+  // after the calibration (camera_timing.h).
+  std::vector<std::optional<CameraTiming>> timings =
+      AdjustedCameraTimings(report.capture_time_model);
+  if (timings.empty()) {
+    timings =
+        MeasuredCameraTimings(report.capture_timing, dataset.reference_camera);
+  }
   for (size_t c = 0; c < timings.size() && c < summary.cameras.size(); ++c) {
     summary.cameras[c].timing = timings[c];
   }

@@ -111,6 +111,39 @@ Json CameraTimingJson(const CameraTiming& timing) {
   return node;
 }
 
+// {"time_offsets_kept", "line_delays_kept", "rms_px", "rms_without_px",
+// "message", "cameras": [{"name", "time_offset_s", "time_offset_sigma_s",
+// "time_offset_estimated", "time_offset_significant", "line_delay_s",
+// "line_delay_sigma_s", "line_delay_estimated", "line_delay_significant"}]}
+// (a sigma null when not computed, JsonNumber; values of a kind not kept are the
+// estimates that auto dropped).
+Json CaptureTimeModelJson(const CalibrationSummary& summary) {
+  const CaptureTimeModel& model = summary.capture_time_model;
+  Json node;
+  node["time_offsets_kept"] = model.time_offsets_kept;
+  node["line_delays_kept"] = model.line_delays_kept;
+  node["rms_px"] = JsonNumber(model.rms_px);
+  node["rms_without_px"] = JsonNumber(model.rms_without_px);
+  node["message"] = model.message;
+  node["cameras"] = Json::array();
+  for (size_t c = 0; c < model.cameras.size(); ++c) {
+    const CameraCaptureTime& time = model.cameras[c];
+    node["cameras"].push_back(
+        {{"name", summary.cameras[c].name},
+         {"time_offset_s", JsonNumber(time.time_offset_s)},
+         {"time_offset_sigma_s", JsonNumber(time.time_offset_sigma_s)},
+         {"time_offset_estimated", time.time_offset_estimated},
+         {"time_offset_significant",
+          static_cast<bool>(model.time_offset_significant[c])},
+         {"line_delay_s", JsonNumber(time.line_delay_s)},
+         {"line_delay_sigma_s", JsonNumber(time.line_delay_sigma_s)},
+         {"line_delay_estimated", time.line_delay_estimated},
+         {"line_delay_significant",
+          static_cast<bool>(model.line_delay_significant[c])}});
+  }
+  return node;
+}
+
 bool WriteJson(const std::string& path, const Json& root, std::string* error) {
   return WriteFileAtomically(
       path, root.dump(2, ' ', false, Json::error_handler_t::replace) + "\n",
@@ -217,6 +250,9 @@ bool WriteCalibrationSummaryJson(const std::string& path,
     }
     root["timestamp_offsets"] = {{"reference_camera", summary.reference_camera},
                                  {"offsets_s", offsets}};
+  }
+  if (summary.capture_time_model.computed) {
+    root["capture_time_model"] = CaptureTimeModelJson(summary);
   }
   if (summary.known_rig_source.empty()) {
     root["known_rig"] = nullptr;

@@ -17,6 +17,7 @@
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
 #include "src/calibration/camera_timing.h"
+#include "src/calibration/capture_time_model.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
@@ -112,6 +113,9 @@ struct CalibrationSummary {
   // "timestamp_offsets" only when one is not 0, so that names without
   // offsets give the summary they gave before.
   std::vector<double> timestamp_offsets_s;
+  // The final adjustment's time model (PipelineReport::capture_time_model);
+  // written as "capture_time_model" only when computed.
+  CaptureTimeModel capture_time_model;
 };
 
 // The per-camera part and the frameset counts of a calibration; the caller

@@ -192,14 +192,19 @@ void WriteTiming(const RigDescriptionCamera& camera, std::ostringstream* yaml) {
   }
   *yaml << "  timeshift_cam_imu: "
         << FormatYamlFloat(timing.time_offset_s - camera.timestamp_offset_s)
-        << "\n"
-        << "  timeshift_cam_imu_sigma: "
-        << FormatYamlFloat(timing.time_offset_sigma_s) << "\n";
+        << "\n";
+  // A sigma that could not be computed (NaN) is not written.
+  if (std::isfinite(timing.time_offset_sigma_s)) {
+    *yaml << "  timeshift_cam_imu_sigma: "
+          << FormatYamlFloat(timing.time_offset_sigma_s) << "\n";
+  }
   if (timing.line_delay_s_per_row) {
     *yaml << "  line_delay: " << FormatYamlFloat(*timing.line_delay_s_per_row)
-          << "\n"
-          << "  line_delay_sigma: "
-          << FormatYamlFloat(timing.line_delay_sigma_s_per_row) << "\n";
+          << "\n";
+    if (std::isfinite(timing.line_delay_sigma_s_per_row)) {
+      *yaml << "  line_delay_sigma: "
+            << FormatYamlFloat(timing.line_delay_sigma_s_per_row) << "\n";
+    }
   }
   *yaml << "  timing_source: " << TimingSourceName(timing.source) << "\n";
 }

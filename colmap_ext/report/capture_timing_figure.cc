@@ -30,11 +30,13 @@ std::string CaptureTimingSvg(const std::string& id, const std::string& title,
   const int height =
       kTop + kRowHeight * static_cast<int>(points.size()) + kBottom;
   const double plot_right = kWidth - kRight;
-  // The axis covers every +-3 sigma bar and zero.
+  // The axis covers every value, its +-3 sigma bar and zero. A sigma that
+  // could not be computed (NaN) has no bars and reads "?".
   double low = 0, high = 0;
   for (const TimingFigurePoint& point : points) {
-    low = std::min(low, point.value - 3 * point.sigma);
-    high = std::max(high, point.value + 3 * point.sigma);
+    const double reach = std::isfinite(point.sigma) ? 3 * point.sigma : 0;
+    low = std::min(low, point.value - reach);
+    high = std::max(high, point.value + reach);
   }
   if (!(high > low)) {
     low = -1;
@@ -75,17 +77,22 @@ std::string CaptureTimingSvg(const std::string& id, const std::string& title,
         FormatSvgCoordinate(kTop + kRowHeight * (k + 0.5) + 4);
     svg << "<text x=\"" << kLeft - 8 << "\" y=\"" << text_y
         << "\" text-anchor=\"end\">" << XmlEscape(point.camera) << "</text>\n";
-    svg << "<line class=\"sigma3\" x1=\"" << x_of(point.value - 3 * point.sigma)
-        << "\" y1=\"" << y << "\" x2=\"" << x_of(point.value + 3 * point.sigma)
-        << "\" y2=\"" << y << "\" stroke=\"#1f77b4\" stroke-width=\"1.5\"/>\n"
-        << "<line class=\"sigma1\" x1=\"" << x_of(point.value - point.sigma)
-        << "\" y1=\"" << y << "\" x2=\"" << x_of(point.value + point.sigma)
-        << "\" y2=\"" << y << "\" stroke=\"#1f77b4\" stroke-width=\"6\"/>\n"
-        << "<circle cx=\"" << x_of(point.value) << "\" cy=\"" << y
+    const bool has_sigma = std::isfinite(point.sigma);
+    if (has_sigma) {
+      svg << "<line class=\"sigma3\" x1=\""
+          << x_of(point.value - 3 * point.sigma) << "\" y1=\"" << y
+          << "\" x2=\"" << x_of(point.value + 3 * point.sigma) << "\" y2=\""
+          << y << "\" stroke=\"#1f77b4\" stroke-width=\"1.5\"/>\n"
+          << "<line class=\"sigma1\" x1=\"" << x_of(point.value - point.sigma)
+          << "\" y1=\"" << y << "\" x2=\"" << x_of(point.value + point.sigma)
+          << "\" y2=\"" << y << "\" stroke=\"#1f77b4\" stroke-width=\"6\"/>\n";
+    }
+    svg << "<circle cx=\"" << x_of(point.value) << "\" cy=\"" << y
         << "\" r=\"4\" fill=\"#d62728\"/>\n"
         << "<text class=\"value\" x=\"" << plot_right + 10 << "\" y=\""
         << text_y << "\">" << Fixed(point.value, 2, true) << " \u00b1 "
-        << Fixed(point.sigma, 2) << " " << XmlEscape(unit) << "</text>\n";
+        << (has_sigma ? Fixed(point.sigma, 2) : std::string("?")) << " "
+        << XmlEscape(unit) << "</text>\n";
   }
   svg << "</svg>";
   return svg.str();

@@ -1,5 +1,6 @@
 #include "src/calibration/camera_timing.h"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -25,12 +26,23 @@ std::optional<TimingSource> TimingSourceFromName(const std::string& name) {
 
 std::string CameraTimingText(const CameraTiming& timing) {
   std::ostringstream text;
+  // A sigma that could not be computed (NaN) reads "?".
+  const auto sigma = [](double value, double unit) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(2);
+    if (std::isfinite(value)) {
+      text << value * unit;
+    } else {
+      text << "?";
+    }
+    return text.str();
+  };
   text << std::fixed << std::setprecision(2) << "dt " << std::showpos
        << timing.time_offset_s * 1e3 << std::noshowpos << " +- "
-       << timing.time_offset_sigma_s * 1e3 << " ms";
+       << sigma(timing.time_offset_sigma_s, 1e3) << " ms";
   if (timing.line_delay_s_per_row) {
     text << " line " << *timing.line_delay_s_per_row * 1e6 << " +- "
-         << timing.line_delay_sigma_s_per_row * 1e6 << " us/row";
+         << sigma(timing.line_delay_sigma_s_per_row, 1e6) << " us/row";
   }
   return text.str();
 }
@@ -54,6 +66,28 @@ std::vector<std::optional<CameraTiming>> MeasuredCameraTimings(
   if (reference_camera >= 0 &&
       reference_camera < static_cast<int>(timings.size())) {
     timings[reference_camera].emplace();
+  }
+  return timings;
+}
+
+std::vector<std::optional<CameraTiming>> AdjustedCameraTimings(
+    const CaptureTimeModel& model) {
+  if (!model.computed || (!model.time_offsets_kept && !model.line_delays_kept)) {
+    return {};
+  }
+  std::vector<std::optional<CameraTiming>> timings(model.cameras.size());
+  for (size_t c = 0; c < model.cameras.size(); ++c) {
+    const CameraCaptureTime& time = model.cameras[c];
+    CameraTiming& camera = timings[c].emplace();
+    camera.source = TimingSource::kEstimatedInAdjustment;
+    if (model.time_offsets_kept && time.time_offset_estimated) {
+      camera.time_offset_s = time.time_offset_s;
+      camera.time_offset_sigma_s = time.time_offset_sigma_s;
+    }
+    if (model.line_delays_kept && time.line_delay_estimated) {
+      camera.line_delay_s_per_row = time.line_delay_s;
+      camera.line_delay_sigma_s_per_row = time.line_delay_sigma_s;
+    }
   }
   return timings;
 }

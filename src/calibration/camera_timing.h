@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "src/calibration/capture_time_model.h"
 #include "src/calibration/capture_timing.h"
 
 namespace rig_calibrator {
@@ -50,5 +51,14 @@ std::string CameraTimingText(const CameraTiming& timing);
 // whose offset is not observable.
 std::vector<std::optional<CameraTiming>> MeasuredCameraTimings(
     const CaptureTiming& timing, int reference_camera);
+
+// Per dataset camera the timing of the final adjustment's time model
+// (source: estimated in the adjustment) when it kept offsets or line delays:
+// the kept kinds' values and sigmas (a sigma NaN when the covariance could not
+// be computed); offsets not kept are 0 +- 0 (the adjustment assumed them),
+// line delays not kept are absent. Nothing (empty vector) when the model kept
+// neither.
+std::vector<std::optional<CameraTiming>> AdjustedCameraTimings(
+    const CaptureTimeModel& model);
 
 }  // namespace rig_calibrator

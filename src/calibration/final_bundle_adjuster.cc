@@ -3,13 +3,55 @@
 #include <colmap/base/camera_models.h>
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "src/calibration/map_anchoring.h"
 #include "src/calibration/rig_adjustment.h"
 
 namespace rig_calibrator {
 namespace {
+
+// The time model needs frameset times, two posed framesets for the rig's
+// motion, and start values per camera (the reference camera's offset 0).
+bool CheckTimeModelInput(const FinalBundleAdjustmentOptions& options,
+                         const RigDataset& dataset,
+                         const RigCalibration& calibration) {
+  const char* const prefix = "Final bundle adjustment: the time model ";
+  if (dataset.frameset_times_s.empty()) {
+    LOG(ERROR) << prefix
+               << "needs frameset times (RigDataset::frameset_times_s), "
+                  "which this dataset does not have";
+    return false;
+  }
+  if (std::count_if(calibration.rig_from_world.begin(),
+                    calibration.rig_from_world.end(),
+                    [](const auto& pose) { return pose.has_value(); }) < 2) {
+    LOG(ERROR) << prefix << "needs at least two framesets with a rig pose";
+    return false;
+  }
+  const size_t num_cameras = dataset.cameras.size();
+  for (const std::vector<double>* values :
+       {&options.initial_time_offsets_s, &options.initial_line_delays_s}) {
+    if (!values->empty() &&
+        (values->size() != num_cameras ||
+         !std::all_of(values->begin(), values->end(),
+                      [](double value) { return std::isfinite(value); }))) {
+      LOG(ERROR) << prefix << "needs one finite start value per camera ("
+                 << num_cameras << "), not " << values->size();
+      return false;
+    }
+  }
+  if (!options.initial_time_offsets_s.empty() &&
+      options.initial_time_offsets_s[dataset.reference_camera] != 0) {
+    LOG(ERROR) << prefix << "holds the reference camera's offset at 0; its "
+                  "start value is "
+               << options.initial_time_offsets_s[dataset.reference_camera];
+    return false;
+  }
+  return true;
+}
 
 // Checks that the calibration matches the (valid) dataset and the options
 // are usable, so that every index used later is valid.
@@ -33,6 +75,10 @@ bool CheckInput(const FinalBundleAdjustmentOptions& options,
        dataset.map_images.empty())) {
     LOG(ERROR) << "Final bundle adjustment: refining the map needs the map "
                   "images and refine_points with use_map_observations";
+    return false;
+  }
+  if (options.HasTimeModel() && !CheckTimeModelInput(options, dataset,
+                                                      calibration)) {
     return false;
   }
   for (size_t camera = 0; camera < dataset.cameras.size(); ++camera) {
@@ -99,12 +145,20 @@ bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
 
 }  // namespace
 
-bool AdjustRig(const FinalBundleAdjustmentOptions& options,
+bool AdjustRig(const FinalBundleAdjustmentOptions& given_options,
                const RigDataset& dataset, RigCalibration* calibration,
                FinalBundleAdjustmentSummary* summary) {
   const auto start_time = std::chrono::steady_clock::now();
-  if (calibration == nullptr || !CheckInput(options, dataset, *calibration)) {
+  if (calibration == nullptr ||
+      !CheckInput(given_options, dataset, *calibration)) {
     return false;
+  }
+  FinalBundleAdjustmentOptions options = given_options;
+  if (options.HasTimeModel() &&
+      options.bundle_solver != BundleSolverBackend::kCeres) {
+    LOG(INFO) << "Final bundle adjustment: the time model runs on Ceres' "
+                 "solver (the own solver has no time parameters)";
+    options.bundle_solver = BundleSolverBackend::kCeres;
   }
   RigAdjustment adjustment(options, dataset, *calibration);
   adjustment.RejectOutliers(/*prune_residuals=*/false);
@@ -118,6 +172,25 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& options,
   result.map_initial_rms_px = adjustment.MapRmsError();
   if (!SolveWithPruning(options, &adjustment, &result)) {
     return false;
+  }
+  if (options.HasTimeModel()) {
+    // The last solve held the motion of the poses before it: solve once more
+    // with the motion of its result (Solve recomputes it), so that the
+    // result is consistent with its own motion model.
+    BundleSolverSummary relinearized;
+    if (!adjustment.Solve(kFinalBundleAdjustmentFunctionTolerance,
+                          &relinearized)) {
+      return false;
+    }
+    result.num_iterations += relinearized.num_successful_steps +
+                             relinearized.num_unsuccessful_steps;
+    result.solver_report = relinearized.BriefReport();
+    result.capture_times =
+        adjustment.CaptureTimes(&result.capture_time_sigma_error);
+    if (!result.capture_time_sigma_error.empty()) {
+      LOG(WARNING) << "Final bundle adjustment: no sigma for the time model ("
+                   << result.capture_time_sigma_error << ")";
+    }
   }
   adjustment.RejectMapOutliers();
   result.final_rms_px = adjustment.RmsError();

@@ -13,6 +13,25 @@
 // are pruned relative to each camera's robust residual spread and the problem
 // is solved again.
 //
+// Time model (estimate_time_offsets / estimate_line_delays, needs the
+// dataset's frameset times): each rig observation of camera c in frameset f
+// is taken at its own instant t_f + delta_c + rho_c (y - 0.5) and uses the
+// rig pose at that instant, rig_from_world(t_f + tau) = M_f(tau)^-1 Q_f, the
+// rig's motion M_f around t_f to third order in tau (frameset_motion.h:
+// why this form and order), its coefficients from the current rig poses,
+// held within a solve and recomputed before each (the cost:
+// timed_rig_reprojection_cost.h). delta_c are refined for the non-reference
+// cameras (delta_ref = 0 defines the rig's clock), rho_c for every camera
+// (a rolling shutter's line delay is observable for the reference camera
+// too). After the last solve the motion is recomputed once more and the
+// problem solved again, so that the result is a fixed point of the model.
+// The time parameters' sigmas are sigma_eff sqrt(diag((J^T J)^-1)) with
+// sigma_eff as in calibration_uncertainty.h (Huber's M-estimate scale of
+// the rig residuals), from ceres::Covariance over the whole problem.
+// The time model runs on Ceres' backend: with the own one selected it
+// switches to Ceres and says so in the log (the own solver's blocks are a
+// pose, a camera and a point per residual).
+//
 // Solver: the problem's own Levenberg-Marquardt
 // (src/solvers/bundle_levenberg_marquardt.h), which eliminates the refined
 // points by their 3 x 3 blocks and factorizes the reduced system over the rig
@@ -22,6 +41,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_solver.h"
@@ -104,6 +124,29 @@ struct FinalBundleAdjustmentOptions {
   // The solver's backend (bundle_solver.h): the own one, or Ceres' to
   // compare with.
   BundleSolverBackend bundle_solver = BundleSolverBackend::kOwn;
+  // The time model (see the top; both false: none, today's adjustment).
+  bool estimate_time_offsets = false;  // delta_c, non-reference cameras
+  bool estimate_line_delays = false;   // rho_c, every camera
+  // Start values per dataset camera (empty: 0); the reference camera's
+  // offset must be 0. Held at these when not estimated.
+  std::vector<double> initial_time_offsets_s;
+  std::vector<double> initial_line_delays_s;
+
+  bool HasTimeModel() const {
+    return estimate_time_offsets || estimate_line_delays;
+  }
+};
+
+// One camera's capture timing from the adjustment's time model: offset
+// delta_c (seconds, the reference camera 0) and line delay rho_c (seconds
+// per row), with their 1-sigma uncertainties (NaN when the covariance could
+// not be computed), and whether each was estimated (else the value is the
+// one held).
+struct CameraCaptureTime {
+  bool time_offset_estimated = false;
+  double time_offset_s = 0, time_offset_sigma_s = 0;
+  bool line_delay_estimated = false;
+  double line_delay_s = 0, line_delay_sigma_s = 0;
 };
 
 struct FinalBundleAdjustmentSummary {
@@ -121,6 +164,10 @@ struct FinalBundleAdjustmentSummary {
   int num_map_residuals = 0, num_map_outliers = 0;
   double map_initial_rms_px = 0, map_final_rms_px = 0;
   std::string solver_report;  // BriefReport of the last solve
+  // With a time model: per dataset camera (else empty); why the sigmas are
+  // missing, if they are.
+  std::vector<CameraCaptureTime> capture_times;
+  std::string capture_time_sigma_error;
 };
 
 // Minimizes the objective above over the correspondences with

@@ -20,6 +20,7 @@
 
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/camera_upgrader.h"
+#include "src/calibration/capture_time_model.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/initial_pose_estimation.h"
@@ -55,6 +56,10 @@ struct PipelineOptions {
   // The capture-time offsets after the final adjustment, when the dataset
   // has frameset times (capture_timing.h).
   CaptureTimingOptions capture_timing;
+  // The final adjustment with capture-time offsets and line delays, when
+  // the dataset has frameset times (capture_time_model.h); its start
+  // estimate and inlier threshold are set from the options above.
+  CaptureTimeModelOptions capture_time_model;
 
   // Correspondences within this radial error of the refined radial rig are
   // handed to the camera upgrade (pixels).

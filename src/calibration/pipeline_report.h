@@ -13,6 +13,7 @@
 #include "src/calibration/calibration_method.h"
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/camera_model_report.h"
+#include "src/calibration/capture_time_model.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/image_coverage.h"
 #include "src/calibration/stage_timing.h"
@@ -65,6 +66,9 @@ struct PipelineReport {
   // (capture_timing.h); `computed` false when the dataset has no frameset
   // times.
   CaptureTiming capture_timing;
+  // The time model of the final adjustment (capture_time_model.h);
+  // `computed` false when it did not run.
+  CaptureTimeModel capture_time_model;
   // Why the pipeline stopped, when CalibrateRig returns false.
   std::string error;
 

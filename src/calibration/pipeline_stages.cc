@@ -344,6 +344,45 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
   return true;
 }
 
+bool RunCaptureTimeModel(const PipelineOptions& options,
+                         CalibrationMethod method, const RigDataset& dataset,
+                         RigCalibration* calibration, PipelineReport* report) {
+  const CaptureTimeModelOptions& model_options = options.capture_time_model;
+  const bool runs =
+      (model_options.time_offsets != CaptureTimeMode::kOff ||
+       model_options.rolling_shutter != CaptureTimeMode::kOff) &&
+      !dataset.frameset_times_s.empty();
+  CaptureTimeModelOptions effective = model_options;
+  effective.inlier_max_error_px = options.upgrade.max_error_px;
+  effective.start_estimate = options.capture_timing;
+  std::string error;
+  if (!runs) {
+    // Only the error of a mode that is on without frameset times.
+    if (!AdjustRigWithCaptureTimeModel(
+            effective, FinalBundleAdjustmentOptionsFor(options, method, dataset),
+            dataset, calibration, &report->capture_time_model, &error)) {
+      report->error = error;
+      return false;
+    }
+    return true;
+  }
+  StageTimer stage("Capture-time model", options.print_progress, report);
+  if (!AdjustRigWithCaptureTimeModel(
+          effective, FinalBundleAdjustmentOptionsFor(options, method, dataset),
+          dataset, calibration, &report->capture_time_model, &error)) {
+    report->error = error;
+    return false;
+  }
+  const CaptureTimeModel& model = report->capture_time_model;
+  if (model.time_offsets_kept || model.line_delays_kept) {
+    report->final_rms_px = model.rms_px;
+  }
+  if (options.print_progress) {
+    std::cout << "  " << model.message << std::endl;
+  }
+  return true;
+}
+
 void RunUncertaintyEstimation(const PipelineOptions& options,
                               CalibrationMethod method,
                               const RigDataset& dataset,
@@ -399,7 +438,9 @@ void RunCaptureTiming(const PipelineOptions& options, const RigDataset& dataset,
             << " +- " << timing.offsets[c].offset_sigma_s * 1e3 << " ms";
     cameras.push_back(static_cast<int>(c));
   }
-  if (cameras.empty()) return;
+  // With the offsets in the final adjustment's model the calibration is not
+  // biased by them: nothing to warn about.
+  if (cameras.empty() || report->capture_time_model.time_offsets_kept) return;
   std::ostringstream message;
   message << "the cameras were not synchronized: " << offsets.str()
           << " (capture time minus " << names[dataset.reference_camera]

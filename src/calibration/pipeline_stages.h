@@ -47,6 +47,14 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               const std::string& stage_name =
                                   "Final bundle adjustment");
 
+// With frameset times and a capture-time mode not off: the final bundle
+// adjustment with the time model (capture_time_model.h) into
+// report->capture_time_model, replacing the calibration when a kind is
+// kept. Fails only when a mode is on and the model cannot run.
+bool RunCaptureTimeModel(const PipelineOptions& options,
+                         CalibrationMethod method, const RigDataset& dataset,
+                         RigCalibration* calibration, PipelineReport* report);
+
 // The uncertainty of the final bundle adjustment's result
 // (src/calibration/calibration_uncertainty.h) into report->uncertainty, and
 // its diagnostics. Never fails the calibration.

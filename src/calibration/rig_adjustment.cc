@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "src/geometry/rig_reprojection_cost.h"
+#include "src/geometry/timed_rig_reprojection_cost.h"
 
 namespace rig_calibrator {
 
@@ -40,6 +41,17 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
     }
   }
   num_given_inliers_ = observations_.size();
+  if (options.HasTimeModel()) {
+    const size_t num_cameras = dataset.cameras.size();
+    time_offsets_ = options.initial_time_offsets_s.empty()
+                        ? std::vector<double>(num_cameras, 0.0)
+                        : options.initial_time_offsets_s;
+    line_delays_ = options.initial_line_delays_s.empty()
+                       ? std::vector<double>(num_cameras, 0.0)
+                       : options.initial_line_delays_s;
+    frameset_motions_.resize(rig_from_world_.size());
+    UpdateFramesetMotions();
+  }
   // Without use_map_observations the map images are still evaluated after
   // the last solve, so that their observations that no longer fit the
   // refined points are rejected (RejectMapOutliers).
@@ -105,10 +117,25 @@ RigAdjustment::ObservationError RigAdjustment::Evaluate(
     const Observation& observation) const {
   const RigImage& image = dataset_.images[observation.image];
   const Correspondence& correspondence = CorrespondenceOf(observation);
-  const Rigid3d cam_from_world =
-      FromPoseParams(cam_from_rig_[image.camera_index]) *
-      FromPoseParams(rig_from_world_[image.frameset_index]);
-  const Eigen::Vector3d point_in_cam = cam_from_world * PointOf(observation);
+  Eigen::Vector3d point_in_cam;
+  if (time_offsets_.empty()) {
+    const Rigid3d cam_from_world =
+        FromPoseParams(cam_from_rig_[image.camera_index]) *
+        FromPoseParams(rig_from_world_[image.frameset_index]);
+    point_in_cam = cam_from_world * PointOf(observation);
+  } else {
+    // The rig pose at the observation's own instant (the time model).
+    const double tau = CaptureTimeOfRow(time_offsets_[image.camera_index],
+                                        line_delays_[image.camera_index],
+                                        correspondence.point2D.y());
+    Eigen::Vector3d point_in_rig;
+    WorldToRigAtOffset(rig_from_world_[image.frameset_index].data(),
+                       PointOf(observation).data(),
+                       frameset_motions_[image.frameset_index], tau,
+                       point_in_rig.data());
+    point_in_cam = FromPoseParams(cam_from_rig_[image.camera_index]) *
+                   point_in_rig;
+  }
   ObservationError error;
   error.depth = point_in_cam.z();
   if (error.depth > 0) {

@@ -4,17 +4,20 @@
 // refined. Internal to AdjustRig; split over
 //   rig_adjustment.cc           state, evaluation, point selection, results,
 //   rig_adjustment_outliers.cc  outlier pruning,
-//   rig_adjustment_problem.cc   the problem and its solve.
+//   rig_adjustment_problem.cc   the problem and its solve,
+//   rig_adjustment_time_model.cc  the time model's motion and results.
 #pragma once
 
 #include <ceres/ceres.h>
 
 #include <array>
 #include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "src/calibration/final_bundle_adjuster.h"
+#include "src/geometry/frameset_motion.h"
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_solver.h"
 #include "src/solvers/huge_page_allocator.h"
@@ -67,6 +70,12 @@ class RigAdjustment {
   // Writes the estimate and the per-image results (see AdjustRig).
   void WriteTo(RigCalibration* calibration) const;
 
+  // With the options' time model: per dataset camera its current offset
+  // and line delay and, after a solve, their sigmas (final_bundle_
+  // adjuster.h); on failure of the covariance the sigmas are NaN and
+  // `sigma_error` says why.
+  std::vector<CameraCaptureTime> CaptureTimes(std::string* sigma_error);
+
  private:
   // One correspondence of one dataset image, with its cost and residual
   // block in the problem (made at the first solve).
@@ -93,6 +102,13 @@ class RigAdjustment {
   // error, and with it its pruning slot.
   using ObservationErrors = LargeVector<ObservationError>;
   using SlotErrors = LargeVector<std::pair<int, ObservationError>>;
+
+  // With a time model: the frameset motions (frameset_motion.h) from the
+  // current rig poses, before each solve.
+  void UpdateFramesetMotions();
+  // sigma_eff^2 (calibration_uncertainty.h) of the rig observations at the
+  // current estimate, with `num_parameters` free parameters.
+  double EffectiveResidualVariance(int64_t num_parameters) const;
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
@@ -153,6 +169,13 @@ class RigAdjustment {
   std::vector<PoseParams> cam_from_rig_;
   std::vector<PoseParams> rig_from_world_;
   std::vector<bool> has_rig_pose_;
+  // The time model (empty without): per camera its offset and line delay,
+  // per frameset its motion (sized once: the costs point into it).
+  std::vector<double> time_offsets_;
+  std::vector<double> line_delays_;
+  std::vector<FramesetMotion> frameset_motions_;
+  // The parameter count of the last solve (for sigma_eff).
+  int64_t num_free_parameters_ = 0;
   LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;
   // The map images (empty unless refine_points and map images):

@@ -1,5 +1,6 @@
 // The problem of the final bundle adjustment: one RigReprojectionCost per
-// observation (a map image's: its cam_from_world as the "rig" pose, a
+// observation (with a time model a TimedRigReprojectionCost, whose extra
+// blocks are the camera's offset and line delay) (a map image's: its cam_from_world as the "rig" pose, a
 // constant identity cam_from_rig), the blocks that are refined, held or
 // partly held, and its solve by the bundle solver (bundle_solver.h, the
 // options' backend) with the refined points eliminated.
@@ -7,6 +8,7 @@
 
 #include "src/calibration/rig_adjustment.h"
 #include "src/geometry/rig_reprojection_cost.h"
+#include "src/geometry/timed_rig_reprojection_cost.h"
 
 namespace rig_calibrator {
 
@@ -15,6 +17,8 @@ bool RigAdjustment::Solve(double function_tolerance,
   if (options_.refine_points && !selection_current_) {
     SelectRefinedPoints();
   }
+  // The motion at the current rig poses, held during the solve.
+  if (options_.HasTimeModel()) UpdateFramesetMotions();
   if (solver_ == nullptr) {
     BundleSolverOptions solver_options;
     solver_options.max_num_iterations = options_.max_num_iterations;
@@ -46,6 +50,8 @@ bool RigAdjustment::Solve(double function_tolerance,
           << summary->factorization_seconds << " s; reduced system "
           << summary->reduced_system_size << " unknowns, "
           << summary->num_points << " points";
+  num_free_parameters_ =
+      summary->reduced_system_size + 3 * static_cast<int64_t>(summary->num_points);
   if (!summary->IsSolutionUsable()) {
     LOG(ERROR) << "Final bundle adjustment failed: " << summary->message;
     return false;
@@ -69,9 +75,17 @@ void RigAdjustment::AddResidualBlocks(
       Observation& observation = observations_[k];
       const RigImage& image = dataset_.images[observation.image];
       const Correspondence& correspondence = CorrespondenceOf(observation);
-      observation.cost.reset(CreateRigReprojectionCost(
-          cameras_[image.camera_index].ModelId(), correspondence.point2D,
-          observation.refined_slot >= 0 ? nullptr : &correspondence.point3D));
+      const Eigen::Vector3d* fixed_point =
+          observation.refined_slot >= 0 ? nullptr : &correspondence.point3D;
+      observation.cost.reset(
+          options_.HasTimeModel()
+              ? CreateTimedRigReprojectionCost(
+                    cameras_[image.camera_index].ModelId(),
+                    correspondence.point2D, fixed_point,
+                    &frameset_motions_[image.frameset_index])
+              : CreateRigReprojectionCost(
+                    cameras_[image.camera_index].ModelId(),
+                    correspondence.point2D, fixed_point));
     } else {
       const MapObservationRef& observation = map_observations[k - num_rig];
       map_costs_[k - num_rig].reset(CreateRigReprojectionCost(
@@ -87,17 +101,20 @@ void RigAdjustment::AddResidualBlocks(
     colmap::Camera& camera = cameras_[image.camera_index];
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
+    // Blocks: Q, P, theta[, delta, rho (time model)][, X].
+    std::vector<double*> blocks = {rig_from_world, cam_from_rig,
+                                   camera.ParamsData()};
+    if (options_.HasTimeModel()) {
+      blocks.push_back(&time_offsets_[image.camera_index]);
+      blocks.push_back(&line_delays_[image.camera_index]);
+    }
     if (observation.refined_slot >= 0) {
-      observation.residual_index = solver_->AddResidualBlock(
-          observation.cost.get(), loss_.get(),
-          {rig_from_world, cam_from_rig, camera.ParamsData(),
-           refined_points_[observation.refined_slot].data()});
+      blocks.push_back(refined_points_[observation.refined_slot].data());
     } else {
       has_fixed_points_ = true;
-      observation.residual_index = solver_->AddResidualBlock(
-          observation.cost.get(), loss_.get(),
-          {rig_from_world, cam_from_rig, camera.ParamsData()});
     }
+    observation.residual_index = solver_->AddResidualBlock(
+        observation.cost.get(), loss_.get(), blocks);
   }
   map_residuals_.reserve(map_observations.size());
   for (int64_t k = 0; k < num_map; ++k) {
@@ -206,6 +223,17 @@ void RigAdjustment::AddParameterBlocks(
       }
       solver_->AddParameterBlock(cameras_[camera].ParamsData(), num_params,
                                  manifold, group);
+      in_group = true;
+    }
+    // The time model's blocks (Ceres' backend: groups do not apply). The
+    // reference camera's offset stays 0: it defines the rig's clock.
+    if (options_.estimate_time_offsets &&
+        static_cast<int>(camera) != dataset_.reference_camera) {
+      solver_->AddParameterBlock(&time_offsets_[camera], 1, nullptr, group);
+      in_group = true;
+    }
+    if (options_.estimate_line_delays) {
+      solver_->AddParameterBlock(&line_delays_[camera], 1, nullptr, group);
       in_group = true;
     }
     group += in_group ? 1 : 0;

@@ -1661,4 +1661,11 @@ void BundleLevenbergMarquardt::Solve(BundleSolverSummary* summary) {
   }
 }
 
+bool BundleLevenbergMarquardt::Variances(
+    const std::vector<const double*>& /*blocks*/,
+    std::vector<double>* /*variances*/, std::string* error) {
+  *error = "the own solver does not compute variances of single blocks";
+  return false;
+}
+
 }  // namespace rig_calibrator

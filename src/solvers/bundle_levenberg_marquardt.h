@@ -98,6 +98,9 @@ class BundleLevenbergMarquardt final : public BundleSolver {
 
   // After a failure midway, the values are the last accepted estimate.
   void Solve(BundleSolverSummary* summary) override;
+  // Not available (the time model runs on Ceres' backend): false.
+  bool Variances(const std::vector<const double*>& blocks,
+                 std::vector<double>* variances, std::string* error) override;
 
   // The Gauss-Newton reduced system at the current values (see the top of
   // the file): J the Jacobian of the residuals with rho(s) = s, in the

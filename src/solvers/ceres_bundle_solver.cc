@@ -19,6 +19,16 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 constexpr int kPointGroup = 0;
 constexpr int kCameraSideGroup = 1;
 
+// The problems' options: Ceres only reads the costs, losses and
+// manifolds; its interface takes them non-const.
+ceres::Problem::Options NonOwningProblemOptions() {
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return problem_options;
+}
+
 }  // namespace
 
 CeresBundleSolver::CeresBundleSolver(
@@ -65,57 +75,102 @@ void CeresBundleSolver::SetFunctionTolerance(double tolerance) {
   options_.function_tolerance = tolerance;
 }
 
-void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
-  using Termination = BundleSolverSummary::Termination;
-  const auto start_time = std::chrono::steady_clock::now();
-  *summary = BundleSolverSummary();
-
-  // Ceres only reads the costs, losses and manifolds; its interface takes
-  // them non-const.
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+void CeresBundleSolver::BuildProblem(
+    ceres::Problem* problem,
+    std::shared_ptr<ceres::ParameterBlockOrdering>* ordering,
+    BundleSolverSummary* summary) const {
+  BundleSolverSummary counts;
   for (const Residual& residual : residuals_) {
     if (!residual.active) continue;
-    problem.AddResidualBlock(const_cast<ceres::CostFunction*>(residual.cost),
-                             const_cast<ceres::LossFunction*>(residual.loss),
-                             residual.parameters);
-    ++summary->num_residual_blocks;
+    problem->AddResidualBlock(const_cast<ceres::CostFunction*>(residual.cost),
+                              const_cast<ceres::LossFunction*>(residual.loss),
+                              residual.parameters);
+    ++counts.num_residual_blocks;
   }
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  auto groups = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<double*> problem_blocks;
-  problem.GetParameterBlocks(&problem_blocks);
+  problem->GetParameterBlocks(&problem_blocks);
   bool has_free_point = false;
   for (double* values : problem_blocks) {
     const auto block = blocks_.find(values);
     const auto point = point_held_.find(values);
     if (block != blocks_.end()) {
-      CHECK_EQ(problem.ParameterBlockSize(values), block->second.size);
+      CHECK_EQ(problem->ParameterBlockSize(values), block->second.size);
       if (block->second.manifold != nullptr) {
-        problem.SetManifold(
+        problem->SetManifold(
             values, const_cast<ceres::Manifold*>(block->second.manifold));
       }
-      summary->reduced_system_size += problem.ParameterBlockTangentSize(values);
-      ordering->AddElementToGroup(values, kCameraSideGroup);
+      counts.reduced_system_size += problem->ParameterBlockTangentSize(values);
+      groups->AddElementToGroup(values, kCameraSideGroup);
     } else if (point != point_held_.end() && !point->second) {
       has_free_point = true;
-      ordering->AddElementToGroup(values, kPointGroup);
+      groups->AddElementToGroup(values, kPointGroup);
     } else {
-      problem.SetParameterBlockConstant(values);
-      ordering->AddElementToGroup(values, kCameraSideGroup);
+      problem->SetParameterBlockConstant(values);
+      groups->AddElementToGroup(values, kCameraSideGroup);
     }
   }
-  summary->num_points = static_cast<int>(
+  counts.num_points = static_cast<int>(
       std::count_if(point_held_.begin(), point_held_.end(),
                     [](const auto& point) { return !point.second; }));
+  *ordering = has_free_point ? groups : nullptr;
+  if (summary != nullptr) {
+    summary->num_residual_blocks = counts.num_residual_blocks;
+    summary->reduced_system_size = counts.reduced_system_size;
+    summary->num_points = counts.num_points;
+  }
+}
+
+bool CeresBundleSolver::Variances(const std::vector<const double*>& blocks,
+                                  std::vector<double>* variances,
+                                  std::string* error) {
+  ceres::Problem problem(NonOwningProblemOptions());
+  std::shared_ptr<ceres::ParameterBlockOrdering> ordering;
+  BuildProblem(&problem, &ordering, nullptr);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (const double* block : blocks) {
+    if (!problem.HasParameterBlock(block) ||
+        problem.ParameterBlockSize(block) != 1 ||
+        problem.IsParameterBlockConstant(block)) {
+      *error = "a block of the variances is not a free one-value block";
+      return false;
+    }
+    pairs.emplace_back(block, block);
+  }
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::SPARSE_QR;
+  covariance_options.apply_loss_function = false;
+  covariance_options.num_threads =
+      options_.num_threads > 0
+          ? options_.num_threads
+          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  ceres::Covariance covariance(covariance_options);
+  if (!covariance.Compute(pairs, &problem)) {
+    *error = "the Jacobian is rank deficient (ceres::Covariance failed)";
+    return false;
+  }
+  variances->clear();
+  for (const double* block : blocks) {
+    double variance = 0;
+    covariance.GetCovarianceBlock(block, block, &variance);
+    variances->push_back(variance);
+  }
+  return true;
+}
+
+void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
+  using Termination = BundleSolverSummary::Termination;
+  const auto start_time = std::chrono::steady_clock::now();
+  *summary = BundleSolverSummary();
+  ceres::Problem problem(NonOwningProblemOptions());
+  std::shared_ptr<ceres::ParameterBlockOrdering> ordering;
+  BuildProblem(&problem, &ordering, summary);
   const double build_seconds = SecondsSince(start_time);
 
   ceres::Solver::Options solver_options;
   solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-  if (has_free_point) solver_options.linear_solver_ordering = ordering;
+  if (ordering != nullptr) solver_options.linear_solver_ordering = ordering;
   solver_options.max_num_iterations = options_.max_num_iterations;
   solver_options.function_tolerance = options_.function_tolerance;
   solver_options.parameter_tolerance = options_.parameter_tolerance;

@@ -27,6 +27,11 @@
 // address): the same minimum, not the same bits.
 #pragma once
 
+#include <ceres/problem.h>
+#include <ceres/ordered_groups.h>
+
+#include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -50,6 +55,10 @@ class CeresBundleSolver final : public BundleSolver {
   void SetFunctionTolerance(double tolerance) override;
   // After a failure, the values are the initial ones (Ceres restores them).
   void Solve(BundleSolverSummary* summary) override;
+  // ceres::Covariance (SPARSE_QR, without the loss) over the problem Solve
+  // builds, at the current values.
+  bool Variances(const std::vector<const double*>& blocks,
+                 std::vector<double>* variances, std::string* error) override;
 
  private:
   struct Block {
@@ -62,6 +71,12 @@ class CeresBundleSolver final : public BundleSolver {
     std::vector<double*> parameters;
     bool active = true;
   };
+
+  // The problem Solve solves (see the top), with its SPARSE_SCHUR ordering
+  // (null without a free point); counts into `summary` when not null.
+  void BuildProblem(ceres::Problem* problem,
+                    std::shared_ptr<ceres::ParameterBlockOrdering>* ordering,
+                    BundleSolverSummary* summary) const;
 
   BundleSolverOptions options_;
   std::unordered_map<const double*, Block> blocks_;

@@ -14,6 +14,7 @@
 #include "src/calibration/pipeline.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/synthetic/synthetic_rig.h"
+#include "tests/src/calibration/calibration_at_truth.h"
 
 namespace rig_calibrator {
 namespace calibration_uncertainty_test {
@@ -30,25 +31,6 @@ SyntheticRigOptions SmallRig(RigPreset preset, unsigned seed) {
   options.missing_image_ratio = 0.1;
   options.seed = seed;
   return options;
-}
-
-// The truth as the start of the final adjustment, every correspondence
-// given as an inlier (the adjustment's pruning must find the wrong ones).
-RigCalibration StartAtTruth(const SyntheticRig& rig) {
-  RigCalibration calibration;
-  calibration.cameras = rig.truth.cameras;
-  calibration.cam_from_rig = rig.truth.cam_from_rig;
-  calibration.camera_calibrated.assign(rig.truth.cameras.size(), true);
-  for (const Rigid3d& pose : rig.truth.rig_from_world) {
-    calibration.rig_from_world.emplace_back(pose);
-  }
-  for (const RigImage& image : rig.dataset.images) {
-    ImageResult result;
-    result.localized = true;
-    result.inlier_mask.assign(image.correspondences.size(), 1);
-    calibration.images.push_back(result);
-  }
-  return calibration;
 }
 
 FinalBundleAdjustmentOptions QuietAdjustment() {
@@ -77,7 +59,7 @@ void AdjustWithTheMap(unsigned seed, SyntheticRig* rig,
   options.outlier_ratio = 0;
   *rig = GenerateSyntheticRig(options);
   KeepCorrespondencesWithMapTracks(rig);
-  *calibration = StartAtTruth(*rig);
+  *calibration = testing::CalibrationAtTruth(*rig);
   ASSERT_TRUE(AdjustRig(MapAdjustment(), rig->dataset, calibration, nullptr));
   *uncertainty =
       EstimateCalibrationUncertainty(MapAdjustment(), rig->dataset, *calibration);
@@ -184,7 +166,7 @@ TEST(CalibrationUncertainty, ExactDataGiveZeroSigmaAndNoNaN) {
     if (with_map) KeepCorrespondencesWithMapTracks(&rig);
     const FinalBundleAdjustmentOptions ba =
         with_map ? MapAdjustment() : QuietAdjustment();
-    RigCalibration calibration = StartAtTruth(rig);
+    RigCalibration calibration = testing::CalibrationAtTruth(rig);
     ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
     const CalibrationUncertainty uncertainty =
         EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
@@ -227,7 +209,7 @@ TEST(CalibrationUncertainty, PointSeenOnceDoesNotPinTheAdjustedMap) {
       Eigen::Vector2d(0.1 / 4.0, -0.2 / 4.0));
   once.point3D_id = 1000000;
   image.correspondences.push_back(once);
-  calibration = StartAtTruth(rig);
+  calibration = testing::CalibrationAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
   ASSERT_EQ(calibration.refined_points3D.count(once.point3D_id), 0u);
   const CalibrationUncertainty uncertainty =
@@ -263,7 +245,7 @@ TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
   }
   ASSERT_EQ(sparse.observations.size(), 2u);
   rig.dataset.map_images.push_back(sparse);
-  calibration = StartAtTruth(rig);
+  calibration = testing::CalibrationAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
   const CalibrationUncertainty uncertainty =
       EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
@@ -278,7 +260,7 @@ TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
 // more than kFramesetsDisagreeFactor times its noise sigma, and only it.
 TEST(CalibrationUncertainty, FramesetsThatDisagreeAreDiagnosed) {
   const SyntheticRig rig = GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 8));
-  const RigCalibration calibration = StartAtTruth(rig);
+  const RigCalibration calibration = testing::CalibrationAtTruth(rig);
   CalibrationUncertainty uncertainty;
   uncertainty.computed = true;
   uncertainty.num_clusters = 8;
@@ -309,7 +291,7 @@ TEST(CalibrationUncertainty, ResultDoesNotDependOnThreadCount) {
   SyntheticRig rig = GenerateSyntheticRig(options);
   KeepCorrespondencesWithMapTracks(&rig);
   FinalBundleAdjustmentOptions ba = MapAdjustment();
-  RigCalibration calibration = StartAtTruth(rig);
+  RigCalibration calibration = testing::CalibrationAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
   std::vector<CalibrationUncertainty> results;
   for (const int num_threads : {1, 2, 3}) {
@@ -336,7 +318,7 @@ TEST(CalibrationUncertainty, HeldParametersHaveZeroSigmaReferenceCameraToo) {
   const SyntheticRig rig = GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 4));
   FinalBundleAdjustmentOptions ba = QuietAdjustment();
   ba.refine_principal_point = false;
-  RigCalibration calibration = StartAtTruth(rig);
+  RigCalibration calibration = testing::CalibrationAtTruth(rig);
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
   const CalibrationUncertainty uncertainty =
       EstimateCalibrationUncertainty(ba, rig.dataset, calibration);
@@ -363,7 +345,7 @@ TEST(CalibrationUncertainty, HeldParametersHaveZeroSigmaReferenceCameraToo) {
 // reported undetermined, never as a number; the other cameras are not.
 TEST(CalibrationUncertainty, UndeterminedCameraIsReportedNotNumbered) {
   const SyntheticRig rig = GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 5));
-  RigCalibration calibration = StartAtTruth(rig);
+  RigCalibration calibration = testing::CalibrationAtTruth(rig);
   const FinalBundleAdjustmentOptions ba = QuietAdjustment();
   ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
   bool kept = false;
@@ -412,7 +394,7 @@ TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
     options.feature_window = poor ? 0.35 : 1.0;
     options.noise_px = 1.0;
     const SyntheticRig rig = GenerateSyntheticRig(options);
-    RigCalibration calibration = StartAtTruth(rig);
+    RigCalibration calibration = testing::CalibrationAtTruth(rig);
     const FinalBundleAdjustmentOptions ba = QuietAdjustment();
     ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr));
     const CalibrationUncertainty uncertainty =
@@ -488,7 +470,7 @@ TEST(CalibrationUncertainty, NormalizedErrorsSpreadAsTheyShouldFromTheTruth) {
       }
       SyntheticRig rig = GenerateSyntheticRig(options);
       if (scenario.with_map) KeepCorrespondencesWithMapTracks(&rig);
-      RigCalibration calibration = StartAtTruth(rig);
+      RigCalibration calibration = testing::CalibrationAtTruth(rig);
       ASSERT_TRUE(AdjustRig(ba, rig.dataset, &calibration, nullptr))
           << scenario.name << " seed " << options.seed;
       const CalibrationUncertainty uncertainty =

@@ -1,0 +1,239 @@
+#include "src/calibration/capture_time_model.h"
+
+#include <glog/logging.h>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "src/calibration/calibration_uncertainty.h"
+#include "src/calibration/inlier_selection.h"
+
+namespace rig_calibrator {
+namespace {
+
+// RMS of the reprojection error over the inliers of the used images.
+double CalibrationRms(const RigCalibration& calibration) {
+  double sum = 0;
+  int64_t count = 0;
+  for (const ImageResult& image : calibration.images) {
+    if (!image.used) continue;
+    sum += image.rms_px * image.rms_px * image.num_inliers;
+    count += image.num_inliers;
+  }
+  return count > 0 ? std::sqrt(sum / count) : 0;
+}
+
+// Beyond the floor and min_sigmas sigma; without a sigma (the covariance
+// failed), beyond the floor when the time model lowered the RMS by
+// min_rms_drop of it.
+bool Significant(double value, double sigma, double min_value,
+                 bool rms_dropped, const CaptureTimeModelOptions& options) {
+  if (!(std::abs(value) > min_value)) return false;
+  return std::isfinite(sigma) ? std::abs(value) > options.min_sigmas * sigma
+                              : rms_dropped;
+}
+
+// The start offsets: the capture-timing estimate of the observable cameras.
+std::vector<double> EstimatedStartOffsets(const CaptureTimeModelOptions& options,
+                                          const RigDataset& dataset,
+                                          const RigCalibration& calibration) {
+  std::vector<double> offsets(dataset.cameras.size(), 0.0);
+  const CaptureTiming timing = MeasureCaptureTiming(
+      dataset, calibration, CalibrationUncertainty(), options.start_estimate);
+  if (!timing.error.empty()) {
+    LOG(INFO) << "Capture-time model: offsets start at 0 (" << timing.error
+              << ")";
+    return offsets;
+  }
+  for (size_t c = 0; c < timing.offsets.size(); ++c) {
+    if (timing.offsets[c].observable &&
+        static_cast<int>(c) != dataset.reference_camera) {
+      offsets[c] = timing.offsets[c].offset_s;
+    }
+  }
+  return offsets;
+}
+
+// The time-model adjustment from `start` (today's parameters, its inliers
+// re-selected); false when it failed.
+bool AdjustWithTimeModel(const CaptureTimeModelOptions& options,
+                         FinalBundleAdjustmentOptions ba_options,
+                         bool offsets, bool line_delays,
+                         const std::vector<double>& start_offsets,
+                         const RigDataset& dataset, const RigCalibration& start,
+                         RigCalibration* result,
+                         FinalBundleAdjustmentSummary* summary) {
+  ba_options.estimate_time_offsets = offsets;
+  ba_options.estimate_line_delays = line_delays;
+  ba_options.initial_time_offsets_s =
+      offsets ? start_offsets : std::vector<double>();
+  ba_options.initial_line_delays_s.clear();
+  *result = start;
+  SelectFullInliers(dataset, options.inlier_max_error_px, result);
+  return AdjustRig(ba_options, dataset, result, summary);
+}
+
+std::string FormatCameras(const RigDataset& dataset,
+                          const CaptureTimeModel& model) {
+  std::ostringstream line;
+  line << std::fixed;
+  for (size_t c = 0; c < model.cameras.size(); ++c) {
+    const CameraCaptureTime& time = model.cameras[c];
+    if (!time.time_offset_estimated && !time.line_delay_estimated) continue;
+    line << " " << dataset.cameras[c].name;
+    if (time.time_offset_estimated) {
+      line << std::setprecision(2) << std::showpos << " "
+           << time.time_offset_s * 1e3 << std::noshowpos << " +- "
+           << time.time_offset_sigma_s * 1e3 << " ms";
+    }
+    if (time.line_delay_estimated) {
+      line << std::setprecision(2) << " " << time.line_delay_s * 1e6 << " +- "
+           << time.line_delay_sigma_s * 1e6 << " us/row";
+    }
+    line << ";";
+  }
+  return line.str();
+}
+
+}  // namespace
+
+bool CaptureTimeModeFromName(const std::string& name, CaptureTimeMode* mode) {
+  for (const CaptureTimeMode value :
+       {CaptureTimeMode::kOff, CaptureTimeMode::kOn, CaptureTimeMode::kAuto}) {
+    if (CaptureTimeModeName(value) == name) {
+      *mode = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string CaptureTimeModeName(CaptureTimeMode mode) {
+  return mode == CaptureTimeMode::kOff  ? "0"
+         : mode == CaptureTimeMode::kOn ? "1"
+                                        : "auto";
+}
+
+bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
+                                   const FinalBundleAdjustmentOptions&
+                                       ba_options,
+                                   const RigDataset& dataset,
+                                   RigCalibration* calibration,
+                                   CaptureTimeModel* model,
+                                   std::string* error) {
+  *model = CaptureTimeModel();
+  const bool offsets_on = options.time_offsets == CaptureTimeMode::kOn;
+  const bool shutter_on = options.rolling_shutter == CaptureTimeMode::kOn;
+  const bool want_offsets = options.time_offsets != CaptureTimeMode::kOff;
+  const bool want_shutter = options.rolling_shutter != CaptureTimeMode::kOff;
+  if (!want_offsets && !want_shutter) return true;
+  if (dataset.frameset_times_s.empty()) {
+    if (offsets_on || shutter_on) {
+      *error =
+          "the capture-time model (--RigCalibrator.time_offsets 1 or "
+          "rolling_shutter 1) needs frameset times, which this dataset does "
+          "not have";
+      return false;
+    }
+    return true;
+  }
+  if (!options.initial_time_offsets_s.empty() &&
+      options.initial_time_offsets_s.size() != dataset.cameras.size()) {
+    *error = "the capture-time model's start offsets are not one per camera";
+    return false;
+  }
+  const std::vector<double> start_offsets =
+      !want_offsets ? std::vector<double>()
+      : options.initial_time_offsets_s.empty()
+          ? EstimatedStartOffsets(options, dataset, *calibration)
+          : options.initial_time_offsets_s;
+
+  model->computed = true;
+  model->rms_without_px = CalibrationRms(*calibration);
+  RigCalibration result;
+  FinalBundleAdjustmentSummary summary;
+  if (!AdjustWithTimeModel(options, ba_options, want_offsets, want_shutter,
+                           start_offsets, dataset, *calibration, &result,
+                           &summary)) {
+    model->message = "the time-model adjustment failed (see the log)";
+    if (offsets_on || shutter_on) {
+      *error = "capture-time model: " + model->message;
+      return false;
+    }
+    LOG(WARNING) << "Capture-time model: " << model->message
+                 << "; the calibration keeps synchronized global shutters";
+    return true;
+  }
+
+  const size_t num_cameras = dataset.cameras.size();
+  model->cameras = summary.capture_times;
+  model->time_offset_significant.assign(num_cameras, false);
+  model->line_delay_significant.assign(num_cameras, false);
+  const bool rms_dropped = summary.final_rms_px <
+                           (1 - options.min_rms_drop) * model->rms_without_px;
+  bool any_offset = false, any_delay = false;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    const CameraCaptureTime& time = model->cameras[c];
+    model->time_offset_significant[c] =
+        time.time_offset_estimated &&
+        Significant(time.time_offset_s, time.time_offset_sigma_s,
+                    options.min_offset_s, rms_dropped, options);
+    const double height = static_cast<double>(calibration->cameras[c].Height());
+    model->line_delay_significant[c] =
+        time.line_delay_estimated &&
+        Significant(time.line_delay_s * height,
+                    time.line_delay_sigma_s * height, options.min_readout_s,
+                    rms_dropped, options);
+    any_offset = any_offset || model->time_offset_significant[c];
+    any_delay = any_delay || model->line_delay_significant[c];
+  }
+  model->time_offsets_kept = offsets_on || (want_offsets && any_offset);
+  model->line_delays_kept = shutter_on || (want_shutter && any_delay);
+  std::ostringstream message;
+  message << "estimated" << FormatCameras(dataset, *model) << " RMS "
+          << std::setprecision(3) << model->rms_without_px << " -> "
+          << summary.final_rms_px << " px; ";
+
+  if (!model->time_offsets_kept && !model->line_delays_kept) {
+    message << "none significant (" << options.min_sigmas
+            << " sigma, 1 ms): the calibration is the synchronized global-"
+               "shutter one";
+    model->rms_px = model->rms_without_px;
+    model->message = message.str();
+    LOG(INFO) << "Capture-time model: " << model->message;
+    return true;
+  }
+  if (model->time_offsets_kept != want_offsets ||
+      model->line_delays_kept != want_shutter) {
+    // Auto dropped one kind: the adjustment again with the other alone.
+    const std::vector<CameraCaptureTime> first = model->cameras;
+    std::vector<double> kept_start;
+    for (const CameraCaptureTime& time : first) {
+      kept_start.push_back(time.time_offset_s);
+    }
+    if (!AdjustWithTimeModel(
+            options, ba_options, model->time_offsets_kept,
+            model->line_delays_kept,
+            model->time_offsets_kept ? kept_start : std::vector<double>(),
+            dataset, *calibration, &result, &summary)) {
+      model->message = "the time-model adjustment failed (see the log)";
+      model->time_offsets_kept = model->line_delays_kept = false;
+      LOG(WARNING) << "Capture-time model: " << model->message;
+      return true;
+    }
+    model->cameras = summary.capture_times;
+  }
+  message << "kept: "
+          << (model->time_offsets_kept && model->line_delays_kept
+                  ? "offsets and line delays"
+              : model->time_offsets_kept ? "offsets"
+                                         : "line delays");
+  model->rms_px = summary.final_rms_px;
+  model->message = message.str();
+  LOG(INFO) << "Capture-time model: " << model->message;
+  *calibration = std::move(result);
+  return true;
+}
+
+}  // namespace rig_calibrator

@@ -1,0 +1,106 @@
+// The capture-time model of the calibration (pipeline step after the final
+// bundle adjustment, --RigCalibrator.time_offsets / rolling_shutter): the
+// final adjustment again with per-camera capture-time offsets delta_c and
+// line delays rho_c (final_bundle_adjuster.h, its time model), kept when
+// asked for or when the data show them.
+//
+// Modes, per kind (offsets, line delays): off, the kind is not estimated;
+// on, it is estimated and kept; auto, it is estimated and kept only when
+// some camera's is significant:
+//   offset:     |delta_c| > min_sigmas sigma(delta_c) and |delta_c| >
+//               min_offset_s (1 ms: below it a sub-millisecond offset is
+//               not told apart from the model's and the map's errors, and a
+//               hardware-triggered rig is synchronized to well below that);
+//   line delay: |rho_c| > min_sigmas sigma(rho_c) and |rho_c| * height_c >
+//               min_readout_s (the readout time of the whole image, 1 ms).
+// Without sigmas (ceres::Covariance found the Jacobian rank deficient, as
+// on the benchmark's 1dr runs with offsets, docs/time_model.md) the sigma
+// test is replaced by the fit: the time model must lower the reprojection
+// RMS by min_rms_drop (5 %) of today's (synchronized data: 0.556 -> 0.556
+// px; offsets in +-50 ms: 1.28 -> 0.68 px).
+// A kind that is kept is kept for every camera (the values of the cameras
+// where it is not significant are estimates near 0, not zeros); when auto
+// keeps one kind and drops the other, the adjustment runs again with the
+// kept one alone; when it keeps none, the calibration is today's (the
+// adjustment without time model), unchanged to the bit.
+//
+// Start. The adjustment starts from today's result (its parameters, and
+// the inliers re-selected within inlier_max_error_px of it, as the final
+// adjustment's own start), the line delays at 0, the offsets at
+// initial_time_offsets_s when given, else at the capture-timing step's
+// estimate from each image's own pose (capture_timing.h) for the cameras it
+// finds observable, else 0. That estimate is biased toward 0 (today's
+// intrinsics absorbed part of the motion) but has the right sign and
+// magnitude, which is all the adjustment needs.
+//
+// Without frameset times the model cannot run: auto and off change nothing,
+// on is an error. The time model's adjustment runs on Ceres' backend.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "src/calibration/capture_timing.h"
+#include "src/calibration/final_bundle_adjuster.h"
+
+namespace rig_calibrator {
+
+enum class CaptureTimeMode { kOff, kOn, kAuto };
+
+// Parses/prints "0", "1", "auto".
+bool CaptureTimeModeFromName(const std::string& name, CaptureTimeMode* mode);
+std::string CaptureTimeModeName(CaptureTimeMode mode);
+
+struct CaptureTimeModelOptions {
+  CaptureTimeMode time_offsets = CaptureTimeMode::kAuto;
+  CaptureTimeMode rolling_shutter = CaptureTimeMode::kAuto;
+  // The significance test of auto (see the top).
+  double min_sigmas = 3.0;
+  double min_offset_s = 1e-3;
+  double min_readout_s = 1e-3;
+  double min_rms_drop = 0.05;
+  // Inliers of the start: within this reprojection error of today's result
+  // (the pipeline sets the final adjustment's own threshold).
+  double inlier_max_error_px = 10.0;
+  // Start offsets per dataset camera (reference 0); empty: from the
+  // capture-timing estimate (see the top).
+  std::vector<double> initial_time_offsets_s;
+  // The capture-timing estimate of the start.
+  CaptureTimingOptions start_estimate;
+};
+
+// What the step did (PipelineReport::capture_time_model; in the summary's
+// "capture_time_model").
+struct CaptureTimeModel {
+  // False when the step did not run (no frameset times, or both kinds off):
+  // nothing below is set.
+  bool computed = false;
+  // Which kinds the calibration now models (false: not estimated, or
+  // estimated and dropped by auto).
+  bool time_offsets_kept = false;
+  bool line_delays_kept = false;
+  // Per dataset camera, the estimate of the last time-model adjustment
+  // (values and sigmas), and per camera whether each is significant.
+  std::vector<CameraCaptureTime> cameras;
+  std::vector<bool> time_offset_significant;
+  std::vector<bool> line_delay_significant;
+  // The adjustment's RMS (pixels) with the time model, and today's.
+  double rms_px = 0, rms_without_px = 0;
+  // One line: what was estimated and kept, and why.
+  std::string message;
+};
+
+// The step above. `calibration` is today's final-adjustment result; it is
+// replaced by the time-model result when a kind is kept. `ba_options` the
+// final adjustment's (without time model). Returns false (with `error`)
+// only when a kind is on and the model cannot run (no frameset times, the
+// adjustment failed); auto then logs why and keeps today's result.
+bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
+                                   const FinalBundleAdjustmentOptions&
+                                       ba_options,
+                                   const RigDataset& dataset,
+                                   RigCalibration* calibration,
+                                   CaptureTimeModel* model,
+                                   std::string* error);
+
+}  // namespace rig_calibrator

@@ -1,0 +1,85 @@
+// The rig's motion around one frameset, for observations taken a little
+// before or after the frameset's nominal time t_f (unsynchronized cameras,
+// rolling shutter): the final bundle adjustment's time model
+// (final_bundle_adjuster.h).
+//
+// Model. With world_from_rig(t) = (R(t), c(t)) the rig's trajectory and
+// Q_f = rig_from_world(t_f), the rig's pose at t_f + tau is Q_f moved by the
+// rig's own motion since t_f, expressed in the rig frame at t_f:
+//
+//   rig_from_world(t_f + tau) = M_f(tau)^-1 Q_f,
+//   M_f(tau) = rig_f_from_rig(t_f + tau) = (Exp(u(tau)), p(tau)),
+//   u(tau) = tau u1 + tau^2/2 u2 + tau^3/6 u3,
+//   p(tau) = tau p1 + tau^2/2 p2 + tau^3/6 p3,
+//
+// u(tau) = Log(R_f^T R(t_f + tau)) (the rotation in the tangent space at
+// R_f) and p(tau) = R_f^T (c(t_f + tau) - c_f) (the rig origin's path in the
+// rig frame at t_f) to third order in tau: u1 is the body angular velocity,
+// u2 its derivative (d/dt Jr(u) u' = u'' at u = 0), p1..p3 the velocity,
+// acceleration and jerk of the rig origin in the rig frame at t_f. So a point
+// of the world is, in the rig frame at t_f + tau,
+//
+//   x_rig = Exp(-u(tau)) (Q_f X - p(tau)).
+//
+// Why this form: the motion is relative to Q_f, so it follows Q_f while an
+// adjustment moves it (held fixed within a solve, recomputed from the
+// adjusted poses between solves), and each observation needs only its own
+// frameset's pose, as without a time model. Why third order: the
+// truncation error is tau^4/24 |u''''|; a first-order (constant twist)
+// model errs by tau^2/2 |u2|, 0.04 deg at tau = 50 ms and 0.5 rad/s^2, twice
+// the rotation accuracy the calibration reaches, and rolling-shutter rows
+// reach tau = 80 ms. Measured on the synthetic time model's trajectory
+// (frameset_motion_test.cc, FramesetMotion.ThirdOrderModelError...).
+//
+// Derivatives. At each frameset with a pose, the degree <= 4 polynomial
+// through the (up to) five nearest posed framesets (the window shifted
+// inward at the ends; fewer knots lower the degree) of u_j = Log(R_f^T R_j)
+// and p_j = R_f^T (c_j - c_f), differentiated at t_f. Its error is O(Delta^5
+// / Delta^k) for the k-th derivative, Delta the frameset interval.
+#pragma once
+
+#include <ceres/rotation.h>
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "src/geometry/rigid3d.h"
+
+namespace rig_calibrator {
+
+// [u1, u2, u3, p1, p2, p3], 3 values each (see above).
+using FramesetMotion = std::array<double, 18>;
+
+// Per frameset the motion above from the rig poses of the framesets that
+// have one (rig_from_world, one entry per frameset) at `times_s` (one per
+// frameset, strictly increasing); zero motion for framesets without a pose.
+// False with `error` when sizes differ or fewer than two framesets have a
+// pose.
+bool ComputeFramesetMotions(const std::vector<double>& times_s,
+                            const std::vector<std::optional<Rigid3d>>&
+                                rig_from_world,
+                            std::vector<FramesetMotion>* motions,
+                            std::string* error);
+
+// x_rig = Exp(-u(tau)) (Q_f X - p(tau)), with Q_f as [qw, qx, qy, qz, tx,
+// ty, tz] (PoseParams), for autodiff and for double.
+template <typename T>
+void WorldToRigAtOffset(const T* rig_from_world, const T* point_in_world,
+                        const FramesetMotion& motion, const T& tau,
+                        T* point_in_rig) {
+  T at_frameset[3];
+  ceres::QuaternionRotatePoint(rig_from_world, point_in_world, at_frameset);
+  const T a1 = tau, a2 = tau * tau / 2.0, a3 = tau * tau * tau / 6.0;
+  T minus_u[3];
+  for (int k = 0; k < 3; ++k) {
+    minus_u[k] = -(a1 * motion[k] + a2 * motion[3 + k] + a3 * motion[6 + k]);
+    at_frameset[k] += rig_from_world[4 + k] -
+                      (a1 * motion[9 + k] + a2 * motion[12 + k] +
+                       a3 * motion[15 + k]);
+  }
+  ceres::AngleAxisRotatePoint(minus_u, at_frameset, point_in_rig);
+}
+
+}  // namespace rig_calibrator

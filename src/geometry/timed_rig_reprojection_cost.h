@@ -1,0 +1,55 @@
+// The cost of the final bundle adjustment with a time model
+// (final_bundle_adjuster.h: unsynchronized cameras, rolling shutter): the
+// reprojection error of a map point X observed at pixel x = (x, y) by camera
+// c of the rig in frameset f, taken at its own instant
+//
+//   t = t_f + tau,  tau = delta_c + rho_c (y - 0.5),
+//
+// delta_c the camera's capture-time offset, rho_c its line delay (seconds
+// per row; the row through y = 0.5, the centre of the top row in COLMAP's
+// pixel convention, is read first: src/synthetic/capture_model.h uses the
+// same convention). The rig pose at t is frameset_motion.h's model,
+// rig_from_world(t_f + tau) = M_f(tau)^-1 Q_f, so
+//
+//   r = pi_theta(P Exp(-u(tau)) (Q X - p(tau))) - x   (pixels),
+//
+// P = cam_from_rig, Q = rig_from_world of the frameset, theta the camera's
+// COLMAP model parameters, M_f's coefficients (u1..3, p1..3) held: they are
+// given by pointer and the adjustment recomputes them between solves.
+// The row is the observed y, not the projected one: the two differ by the
+// keypoint's noise, whose effect rho_c |dr/dt| |noise| is 10^-3 px and
+// below (25 us per row, image motion of 100 px/s, 0.5 px of noise).
+//
+// Parameter blocks, in order: Q and P as [qw, qx, qy, qz, tx, ty, tz],
+// theta (the model's kNumParams), delta_c (1), rho_c (1) and, when the point
+// is refined, X (3). A block the adjustment does not add (the reference
+// camera's delta, which is 0; rho when rolling shutter is off) is a
+// constant of the solver. Jacobians by automatic differentiation: the time
+// model runs on Ceres' backend only (final_bundle_adjuster.h).
+// A point that is not in front of the camera is an invalid evaluation.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Core>
+
+#include "src/geometry/frameset_motion.h"
+
+namespace rig_calibrator {
+
+// r above for the COLMAP model `model_id`, observing `observed`; `point3D`
+// fixed, or null for a refined point (the sixth block); `motion` the
+// frameset's, read at every evaluation (it must outlive the cost). Null for
+// an unknown model id. The caller owns the result.
+ceres::CostFunction* CreateTimedRigReprojectionCost(
+    int model_id, const Eigen::Vector2d& observed,
+    const Eigen::Vector3d* point3D, const FramesetMotion* motion);
+
+// tau = delta_c + rho_c (y - 0.5): when the row through pixel y is taken,
+// relative to t_f (templated for autodiff).
+template <typename T>
+T CaptureTimeOfRow(const T& time_offset_s, const T& line_delay_s, double y) {
+  return time_offset_s + line_delay_s * (y - 0.5);
+}
+
+}  // namespace rig_calibrator
