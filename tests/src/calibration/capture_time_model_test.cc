@@ -354,7 +354,7 @@ TEST(CaptureTimeModel, SynchronizedGlobalShutterAutoKeepsNothing) {
 
 // Asked for without frameset times: an error naming the cause; auto: the
 // step does not run.
-TEST(CaptureTimeModel, WithoutFramesetTimesOnIsAnErrorAutoDoesNothing) {
+TEST(CaptureTimeModel, WithoutFramesetTimesOnIsAnErrorAutoChangesNothing) {
   SyntheticRigOptions options = TimedRingOptions(12, 40, kRateHz);
   SyntheticRig rig = GenerateSyntheticRig(options);
   SetKnownIntrinsics(&rig);
