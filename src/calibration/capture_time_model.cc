@@ -24,14 +24,12 @@ double CalibrationRms(const RigCalibration& calibration) {
   return count > 0 ? std::sqrt(sum / count) : 0;
 }
 
-// Beyond the floor and min_sigmas sigma; without a sigma (the covariance
-// failed), beyond the floor when the time model lowered the RMS by
-// min_rms_drop of it.
+// Beyond the floor and min_sigmas sigma; never without a sigma (the
+// covariance failed; see the header).
 bool Significant(double value, double sigma, double min_value,
-                 bool rms_dropped, const CaptureTimeModelOptions& options) {
-  if (!(std::abs(value) > min_value)) return false;
-  return std::isfinite(sigma) ? std::abs(value) > options.min_sigmas * sigma
-                              : rms_dropped;
+                 const CaptureTimeModelOptions& options) {
+  return std::abs(value) > min_value && std::isfinite(sigma) &&
+         std::abs(value) > options.min_sigmas * sigma;
 }
 
 // The start offsets: the capture-timing estimate of the observable cameras.
@@ -170,21 +168,19 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
   model->cameras = summary.capture_times;
   model->time_offset_significant.assign(num_cameras, false);
   model->line_delay_significant.assign(num_cameras, false);
-  const bool rms_dropped = summary.final_rms_px <
-                           (1 - options.min_rms_drop) * model->rms_without_px;
   bool any_offset = false, any_delay = false;
   for (size_t c = 0; c < num_cameras; ++c) {
     const CameraCaptureTime& time = model->cameras[c];
     model->time_offset_significant[c] =
         time.time_offset_estimated &&
         Significant(time.time_offset_s, time.time_offset_sigma_s,
-                    options.min_offset_s, rms_dropped, options);
+                    options.min_offset_s, options);
     const double height = static_cast<double>(calibration->cameras[c].Height());
     model->line_delay_significant[c] =
         time.line_delay_estimated &&
         Significant(time.line_delay_s * height,
                     time.line_delay_sigma_s * height, options.min_readout_s,
-                    rms_dropped, options);
+                    options);
     any_offset = any_offset || model->time_offset_significant[c];
     any_delay = any_delay || model->line_delay_significant[c];
   }
@@ -196,9 +192,18 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
           << summary.final_rms_px << " px; ";
 
   if (!model->time_offsets_kept && !model->line_delays_kept) {
-    message << "none significant (" << options.min_sigmas
-            << " sigma, 1 ms): the calibration is the synchronized global-"
-               "shutter one";
+    bool sigmas_missing = false;
+    for (const CameraCaptureTime& time : model->cameras) {
+      sigmas_missing = sigmas_missing ||
+                       (time.time_offset_estimated &&
+                        !std::isfinite(time.time_offset_sigma_s)) ||
+                       (time.line_delay_estimated &&
+                        !std::isfinite(time.line_delay_sigma_s));
+    }
+    message << "none significant (" << options.min_sigmas << " sigma, 1 ms"
+            << (sigmas_missing ? "; no sigma, so none can be: 1 keeps them"
+                               : "")
+            << "): the calibration is the synchronized global-shutter one";
     model->rms_px = model->rms_without_px;
     model->message = message.str();
     LOG(INFO) << "Capture-time model: " << model->message;
