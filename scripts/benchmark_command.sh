@@ -17,6 +17,13 @@
 #   RIG_CALIBRATOR_BUILD_DIR  build folder (default: build/)
 #   BENCHMARK_CAMERAS         cameras on the ring (default 10)
 #   BENCHMARK_THREADS         --RigCalibrator.num_threads (default -1: all)
+#   BENCHMARK_TIME_MODEL      1: the rig is unsynchronized with rolling
+#                             shutters (framesets at 5 Hz, the rig at
+#                             1.5 m/s and 60 deg/s, offsets in +-50 ms, line
+#                             delays 20-30 us/row), the frameset times are
+#                             given (the names are frameset indices:
+#                             timestamp_unit_s 0.2), and a third run has the
+#                             time model off: the time model's cost
 set -euo pipefail
 
 log_tag=benchmark_command
@@ -30,6 +37,17 @@ sizes=("$@")
 [[ ${#sizes[@]} -gt 0 ]] || sizes=(500)
 cameras="${BENCHMARK_CAMERAS:-10}"
 threads="${BENCHMARK_THREADS:--1}"
+time_model="${BENCHMARK_TIME_MODEL:-0}"
+runs=(defaults true_models)
+timed_data=()
+timed_options=()
+if [[ "$time_model" == 1 ]]; then
+  runs+=(time_model_off)
+  timed_data=(--frameset_rate_hz 5 --speed_m_s 1.5 --max_turn_rate_deg_s 60
+              --max_time_offset_ms 50 --line_delay_us 20,30)
+  timed_options=(--RigCalibrator.timestamp_tolerance 0.5
+                 --RigCalibrator.timestamp_unit_s 0.2)
+fi
 [[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 [[ -x /usr/bin/time ]] || die "/usr/bin/time is needed (apt-get install time)"
 mkdir -p "$results" || die "cannot create $results"
@@ -58,24 +76,31 @@ for framesets in "${sizes[@]}"; do
     --ring_num_cameras "$cameras" --num_framesets "$framesets" \
     --points_per_image 300 --outlier_ratio 0.3 --missing_image_ratio 0.1 \
     --num_map_images 60 --map_observations_per_image 3000 \
-    --map_noise_px 0.5 --map_point_noise 0.005 >"$case_dir/synthetic.log" ||
+    --map_noise_px 0.5 --map_point_noise 0.005 "${timed_data[@]}" \
+    >"$case_dir/synthetic.log" ||
     die "generating the data failed; see $case_dir/synthetic.log"
   true_models="$(sed -n 's/.*--RigCalibrator.camera_model \([^ ]*\).*/\1/p' \
     "$case_dir/synthetic.log" | head -n 1)"
   [[ -n "$true_models" ]] || die "no camera models in $case_dir/synthetic.log"
   inputs=(--correspondences_path "$data/correspondences.txt"
-          --input_path "$data/sparse")
+          --input_path "$data/sparse" "${timed_options[@]}")
   echo "[$log_tag] defaults"
   run_timed "the defaults" "$case_dir/defaults" "${inputs[@]}"
   echo "[$log_tag] true models given by hand"
   run_timed "the true models" "$case_dir/true_models" "${inputs[@]}" \
     --RigCalibrator.camera_model "$true_models"
+  if [[ "$time_model" == 1 ]]; then
+    echo "[$log_tag] defaults, the time model off"
+    run_timed "the time model off" "$case_dir/time_model_off" "${inputs[@]}" \
+      --RigCalibrator.time_offsets 0 --RigCalibrator.rolling_shutter 0
+  fi
 done
 
-/usr/bin/python3 - "$results" "$cameras" "${sizes[@]}" <<'EOF'
+/usr/bin/python3 - "$results" "$cameras" "${runs[*]}" "${sizes[@]}" <<'EOF'
 import json, math, os, re, sys
 
-results, cameras, sizes = sys.argv[1], int(sys.argv[2]), [int(s) for s in sys.argv[3:]]
+results, cameras = sys.argv[1], int(sys.argv[2])
+runs, sizes = sys.argv[3].split(), [int(s) for s in sys.argv[4:]]
 
 def time_report(path):
     text = open(path).read()
@@ -98,7 +123,8 @@ def worst(errors_path):
             if cams and key in cams[0]}
 
 out = ["# The calibrate command with its defaults", "",
-       "Measured by `bash scripts/benchmark_command.sh RESULTS " +
+       "Measured by `" + ("BENCHMARK_TIME_MODEL=1 " if "time_model_off" in runs
+                          else "") + "bash scripts/benchmark_command.sh RESULTS " +
        " ".join(map(str, sizes)) + "` (" + str(os.cpu_count()) +
        " cores). The defaults: camera models `auto`, refine_map, the "
        "uncertainty; wall and CPU (user + system) of the whole command, "
@@ -106,7 +132,7 @@ out = ["# The calibrate command with its defaults", "",
 rows = {}
 for framesets in sizes:
     case = os.path.join(results, "ring%d_%d" % (cameras, framesets))
-    for run in ("defaults", "true_models"):
+    for run in runs:
         wall, cpu, rss = time_report(os.path.join(case, run + ".time"))
         timings = json.load(open(os.path.join(case, run, "timings.json")))
         rows[(framesets, run)] = (wall, cpu, rss, timings,

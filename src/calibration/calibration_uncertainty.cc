@@ -22,9 +22,11 @@
 
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/pipeline_report.h"
+#include "src/geometry/frameset_motion.h"
 #include "src/geometry/pose_jacobians.h"
 #include "src/geometry/rig_reprojection_cost.h"
 #include "src/geometry/tangent_jacobian_cost.h"
+#include "src/geometry/timed_rig_reprojection_cost.h"
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_levenberg_marquardt.h"
 #include "src/solvers/huge_page_allocator.h"
@@ -98,6 +100,10 @@ struct Observation {
   Eigen::Vector2d observed = Eigen::Vector2d::Zero();
   int point_index = -1;  // into the refined points; -1: fixed point
   int rig_camera = -1;  // the rig camera, -1 for a map image
+  // With the time model, a rig observation's capture-time offset and line
+  // delay (its camera's).
+  double* time_offset = nullptr;
+  double* line_delay = nullptr;
   int map_camera = -1;  // a map image's camera
   // The cluster of the between-framesets covariance: the frameset of a rig
   // image, num_framesets + m for map image m.
@@ -186,6 +192,7 @@ class UncertaintyProblem {
   int undetermined_map_image() const { return undetermined_map_image_; }
 
  private:
+  bool SetUpTimeModel(std::string* error);
   void CollectObservations();
   int AddBlock(int dim, std::vector<int>* slot, int index);
   void AssignBlocks();
@@ -218,6 +225,12 @@ class UncertaintyProblem {
   // The intrinsics of the rig cameras and of the map cameras, copied: the
   // solver takes non-const values.
   std::vector<std::vector<double>> params_, map_params_;
+  // The time model (final_bundle_adjuster.h), empty without: per rig camera
+  // its offset and line delay (the options' values: the result's), per
+  // frameset the rig's motion around it from the result's rig poses, held
+  // as in the adjustment.
+  std::vector<double> time_offsets_, line_delays_;
+  std::vector<FramesetMotion> frameset_motions_;
   LargeVector<Observation> observations_;  // 10^6: huge_page_allocator.h
   std::vector<int64_t> point_ids_;  // refined points in the problem
   std::unordered_map<int64_t, int> point_index_;
@@ -230,7 +243,8 @@ class UncertaintyProblem {
   // layout (AddParameterBlocks).
   std::vector<Block> blocks_;
   std::vector<int> rig_pose_block_, map_pose_block_, map_intrinsics_block_,
-      intrinsics_block_, extrinsics_block_;
+      intrinsics_block_, extrinsics_block_, time_offset_block_,
+      line_delay_block_;
   int num_o_ = 0, num_c_ = 0;  // scalar dimensions of O and C
   int num_o_blocks_ = 0;       // blocks [0, num_o_blocks_) are O
   // The final adjustment's problem over observations_ and its reduced
@@ -279,6 +293,26 @@ ceres::CostFunction* UncertaintyProblem::CostFor(int model_id) const {
   return it->second.get();
 }
 
+// With the options' time model: the offsets and line delays of the result
+// (the options' values) and the frameset motions of its rig poses.
+bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
+  if (!options_.HasTimeModel()) return true;
+  const size_t num_cameras = calibration_.cameras.size();
+  const auto values = [&](const std::vector<double>& given) {
+    return given.size() == num_cameras ? given
+                                       : std::vector<double>(num_cameras, 0.0);
+  };
+  time_offsets_ = values(options_.initial_time_offsets_s);
+  line_delays_ = values(options_.initial_line_delays_s);
+  if (!ComputeFramesetMotions(dataset_.frameset_times_s,
+                              calibration_.rig_from_world, &frameset_motions_,
+                              error)) {
+    *error = "the time model's frameset motions: " + *error;
+    return false;
+  }
+  return true;
+}
+
 // The observations of the final adjustment's last state (final_bundle_
 // adjuster.h): the inliers of the images of calibrated cameras with a rig
 // pose and, with map observations, the map images' non-rejected
@@ -320,6 +354,10 @@ void UncertaintyProblem::CollectObservations() {
       observation.params = params_[c].data();
       observation.observed = correspondence.point2D;
       observation.rig_camera = c;
+      if (!frameset_motions_.empty()) {
+        observation.time_offset = &time_offsets_[c];
+        observation.line_delay = &line_delays_[c];
+      }
       const auto refined =
           calibration_.refined_points3D.find(correspondence.point3D_id);
       if (refine_points && correspondence.point3D_id >= 0 &&
@@ -412,6 +450,8 @@ void UncertaintyProblem::AssignBlocks() {
   map_intrinsics_block_.assign(map_free_intrinsics_.size(), -1);
   intrinsics_block_.assign(num_cameras, -1);
   extrinsics_block_.assign(num_cameras, -1);
+  time_offset_block_.assign(num_cameras, -1);
+  line_delay_block_.assign(num_cameras, -1);
   std::vector<char> camera_observed(num_cameras, 0);
   const int num_framesets = static_cast<int>(rig_from_world_.size());
   for (const Observation& observation : observations_) {
@@ -437,6 +477,10 @@ void UncertaintyProblem::AssignBlocks() {
     if (options_.refine_extrinsics && c != dataset_.reference_camera) {
       AddBlock(6, &extrinsics_block_, c);
     }
+    if (options_.estimate_time_offsets && c != dataset_.reference_camera) {
+      AddBlock(1, &time_offset_block_, c);
+    }
+    if (options_.estimate_line_delays) AddBlock(1, &line_delay_block_, c);
   }
   num_o_blocks_ = static_cast<int>(num_o_blocks);
   int offset = 0;
@@ -511,13 +555,22 @@ void UncertaintyProblem::AddParameterBlocks() {
   }
   int group = num_o_blocks_;
   for (size_t c = 0; c < params_.size(); ++c) {
-    if (intrinsics_block_[c] < 0 && extrinsics_block_[c] < 0) continue;
+    if (intrinsics_block_[c] < 0 && extrinsics_block_[c] < 0 &&
+        time_offset_block_[c] < 0 && line_delay_block_[c] < 0) {
+      continue;
+    }
     if (intrinsics_block_[c] >= 0) {
       add_intrinsics(&params_[c], free_intrinsics_[c], group);
     }
     if (extrinsics_block_[c] >= 0) {
       solver_->AddParameterBlock(cam_from_rig_[c].data(), 7, &pose_manifold_,
                                  group);
+    }
+    if (time_offset_block_[c] >= 0) {
+      solver_->AddParameterBlock(&time_offsets_[c], 1, nullptr, group);
+    }
+    if (line_delay_block_[c] >= 0) {
+      solver_->AddParameterBlock(&line_delays_[c], 1, nullptr, group);
     }
     ++group;
   }
@@ -542,9 +595,15 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
 #pragma omp parallel for schedule(static) num_threads(NumThreads())
   for (int64_t k = 0; k < num_observations; ++k) {
     const Observation& observation = observations_[k];
-    residual_costs_[k].reset(CreateRigReprojectionCost(
-        observation.model_id, observation.observed,
-        observation.point_index >= 0 ? nullptr : &observation.point));
+    const Eigen::Vector3d* fixed_point =
+        observation.point_index >= 0 ? nullptr : &observation.point;
+    residual_costs_[k].reset(
+        observation.time_offset != nullptr
+            ? CreateTimedRigReprojectionCost(
+                  observation.model_id, observation.observed, fixed_point,
+                  &frameset_motions_[observation.cluster])
+            : CreateRigReprojectionCost(observation.model_id,
+                                        observation.observed, fixed_point));
   }
   std::vector<double*> parameters;
   for (int64_t k = 0; k < num_observations; ++k) {
@@ -556,6 +615,10 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
     }
     parameters.assign(
         {observation.rig_pose, observation.cam_pose, observation.params});
+    if (observation.time_offset != nullptr) {
+      parameters.push_back(observation.time_offset);
+      parameters.push_back(observation.line_delay);
+    }
     if (refined) parameters.push_back(points_[observation.point_index].data());
     observation.residual = solver_->AddResidualBlock(
         residual_costs_[k].get(), nullptr, parameters);
@@ -1071,6 +1134,17 @@ void UncertaintyProblem::FillCameras(const UncertaintyOptions& options,
       camera.center_in_rig_stddev(k) =
           extrinsics_determined ? larger(row) : kNaN;
     }
+    // The time model's parameters: the larger of the two estimates.
+    const auto time_stddev = [&](int block) {
+      if (block < 0) return 0.0;
+      const int k = blocks_[block].offset - num_o_;
+      if (undetermined_c_[k]) return kNaN;
+      double value = variance * covariance_c_(k, k);
+      if (between) value = std::max(value, cluster_covariance_c_(k, k));
+      return std::sqrt(std::max(0.0, value));
+    };
+    camera.time_offset_stddev_s = time_stddev(time_offset_block_[c]);
+    camera.line_delay_stddev_s = time_stddev(line_delay_block_[c]);
     if (camera.determined)
       FillProjection(static_cast<int>(c), options, &camera);
   }
@@ -1121,6 +1195,7 @@ std::string UncertaintyProblem::Method() const {
 
 bool UncertaintyProblem::Run(const UncertaintyOptions& options,
                              CalibrationUncertainty* result) {
+  if (!SetUpTimeModel(&result->message)) return false;
   CollectObservations();
   if (observations_.empty()) {
     result->message = "no inlier observation";

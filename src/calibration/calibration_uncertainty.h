@@ -39,6 +39,15 @@
 // RigPoseManifold's (d, t), R' = Exp(2 d) R: the covariance is computed in
 // them and reported in (w, t), w = 2 d.
 //
+// Time model. When ba_options has one (estimate_time_offsets /
+// estimate_line_delays, their values in initial_time_offsets_s /
+// initial_line_delays_s: the result's), the rig observations are the
+// adjustment's timed ones (timed_rig_reprojection_cost.h, the frameset
+// motions from the result's rig poses, held as in the adjustment), and the
+// estimated offsets and line delays are parameters of C, in their camera's
+// block: their sigmas come out of the same marginalization, covering the
+// map, the rig poses and the intrinsics they trade off against.
+//
 // Gauge. The reference camera's cam_from_rig is the identity and has no
 // uncertainty. Fixed map points (refine_points off, or points seen once) or
 // fixed map images (refine_map off) fix the world frame and scale, and the
@@ -158,6 +167,12 @@ struct CameraUncertainty {
   // computed): above ~1.5 the framesets disagree more than the pixel noise
   // explains, and the between-framesets sigma is the one reported.
   double between_framesets_factor = 0;
+  // With the final adjustment's time model (final_bundle_adjuster.h): the
+  // standard deviations of the capture-time offset (seconds) and the line
+  // delay (seconds per row), the larger of the two estimates; 0 when not
+  // estimated, NaN when undetermined. Not in `covariance`.
+  double time_offset_stddev_s = 0;
+  double line_delay_stddev_s = 0;
   ProjectionUncertainty projection;
 };
 

@@ -1,5 +1,6 @@
 #include "src/calibration/camera_model_stage.h"
 
+#include <glog/logging.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -7,6 +8,8 @@
 #include <set>
 
 #include "src/calibration/pipeline_stages.h"
+#include "src/geometry/frameset_motion.h"
+#include "src/geometry/timed_rig_reprojection_cost.h"
 
 namespace rig_calibrator {
 namespace {
@@ -20,9 +23,27 @@ CameraModelReport& CameraModelReportOf(const RigDataset& dataset,
 
 // The final inliers of camera `camera_index`: observed pixels, points in
 // the rig frame (refined map points where the map was refined), framesets.
+// With the capture-time model's kept kinds (capture_time_model.h) the point
+// is in the rig frame of the row's own instant, t_f + tau with tau =
+// delta_c + rho_c (y - 0.5) (frameset_motion.h: the adjustment's motion
+// model), so that the rows fit the camera as the adjustment did.
 AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
                                   const RigCalibration& calibration,
+                                  const CaptureTimeModel& time_model,
                                   const int camera_index) {
+  const bool timed =
+      time_model.time_offsets_kept || time_model.line_delays_kept;
+  std::vector<FramesetMotion> motions;
+  double offset = 0, line_delay = 0;
+  if (timed) {
+    std::string error;
+    CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
+                                 calibration.rig_from_world, &motions, &error))
+        << error << " (the capture-time model ran on these poses)";
+    const CameraCaptureTime& time = time_model.cameras[camera_index];
+    offset = time_model.time_offsets_kept ? time.time_offset_s : 0;
+    line_delay = time_model.line_delays_kept ? time.line_delay_s : 0;
+  }
   AdjustedCameraRows rows;
   for (size_t i = 0; i < dataset.images.size(); ++i) {
     const RigImage& image = dataset.images[i];
@@ -40,11 +61,22 @@ AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
       const Correspondence& correspondence = image.correspondences[k];
       const auto refined =
           calibration.refined_points3D.find(correspondence.point3D_id);
+      const Eigen::Vector3d& point = refined != calibration.refined_points3D.end()
+                                         ? refined->second
+                                         : correspondence.point3D;
       rows.points2D.push_back(correspondence.point2D);
-      rows.points_rig.push_back(
-          rig_from_world * (refined != calibration.refined_points3D.end()
-                                ? refined->second
-                                : correspondence.point3D));
+      if (timed) {
+        const PoseParams pose = ToPoseParams(rig_from_world);
+        const double tau = CaptureTimeOfRow(offset, line_delay,
+                                            correspondence.point2D.y());
+        Eigen::Vector3d point_rig;
+        WorldToRigAtOffset(pose.data(), point.data(),
+                           motions[image.frameset_index], tau,
+                           point_rig.data());
+        rows.points_rig.push_back(point_rig);
+      } else {
+        rows.points_rig.push_back(rig_from_world * point);
+      }
       rows.framesets.push_back(image.frameset_index);
     }
   }
@@ -56,13 +88,14 @@ AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
 // check's standard error).
 void FinalInlierPixels(const RigDataset& dataset,
                        const RigCalibration& calibration,
+                       const CaptureTimeModel& time_model,
                        const int camera_index,
                        std::vector<Eigen::Vector2d>* observed,
                        std::vector<Eigen::Vector2d>* projected,
                        std::vector<int>* framesets) {
   const colmap::Camera& camera = calibration.cameras[camera_index];
   const AdjustedCameraRows rows =
-      AdjustedRowsOf(dataset, calibration, camera_index);
+      AdjustedRowsOf(dataset, calibration, time_model, camera_index);
   for (size_t r = 0; r < rows.points2D.size(); ++r) {
     const Eigen::Vector3d point_cam =
         calibration.cam_from_rig[camera_index] * rows.points_rig[r];
@@ -260,7 +293,8 @@ bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
     camera_options.refine_principal_point =
         ba_options.refine_principal_point &&
         dataset.cameras[c].refinement.principal_point;
-    rows[j] = AdjustedRowsOf(dataset, *calibration, c);
+    rows[j] =
+        AdjustedRowsOf(dataset, *calibration, report->capture_time_model, c);
     fitted[j] = calibration->cameras[c];
     fitted_cam_from_rig[j] = calibration->cam_from_rig[c];
     chosen[j] = ChooseModelOnAdjustedRig(camera_options, rows[j], &fitted[j],
@@ -343,7 +377,8 @@ void CheckCameraModels(const PipelineOptions& options,
         CheckModelValidity(camera, options.model_selection.validity);
     std::vector<Eigen::Vector2d> observed, projected;
     std::vector<int> images;
-    FinalInlierPixels(dataset, calibration, c, &observed, &projected, &images);
+    FinalInlierPixels(dataset, calibration, report->capture_time_model, c,
+                      &observed, &projected, &images);
     profiles[c] = ComputeRadialResidualProfile(
         Eigen::Vector2d(camera.PrincipalPointX(), camera.PrincipalPointY()),
         observed, projected, images, profile_options);

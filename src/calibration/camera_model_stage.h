@@ -54,6 +54,9 @@ void ChooseCameraModelsFromPoses(const PipelineOptions& options,
 // again). The choice is marked uncertain (warning
 // "uncertain_model_choice") with fewer framesets than
 // ModelSelectionOptions::min_num_framesets, or when the upgrade's was.
+// When the capture-time model (report->capture_time_model) kept offsets or
+// line delays, each observation's point is taken in the rig frame of its
+// own capture instant, as in the adjustment; so is the check below.
 bool ChooseCameraModelsOnAdjustedRig(const PipelineOptions& options,
                                      CalibrationMethod method,
                                      const RigDataset& dataset,

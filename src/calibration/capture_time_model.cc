@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "src/calibration/calibration_uncertainty.h"
@@ -53,6 +54,22 @@ std::vector<double> EstimatedStartOffsets(const CaptureTimeModelOptions& options
   return offsets;
 }
 
+// The sigmas of a time-model result: the calibration's uncertainty with
+// its time model (calibration_uncertainty.h; NaN when it is not computed,
+// with `error` saying why).
+void EstimateCaptureTimeSigmas(const FinalBundleAdjustmentOptions& ba_options,
+                          bool offsets, bool line_delays,
+                          const RigDataset& dataset,
+                          const RigCalibration& result,
+                          std::vector<CameraCaptureTime>* times,
+                          std::string* error) {
+  const CalibrationUncertainty uncertainty = EstimateCalibrationUncertainty(
+      WithCaptureTimes(ba_options, offsets, line_delays, *times), dataset,
+      result);
+  *error = uncertainty.computed ? "" : uncertainty.message;
+  SetCaptureTimeSigmas(uncertainty, times);
+}
+
 // The time-model adjustment from `start` (today's parameters, its inliers
 // re-selected); false when it failed.
 bool AdjustWithTimeModel(const CaptureTimeModelOptions& options,
@@ -95,6 +112,52 @@ std::string FormatCameras(const RigDataset& dataset,
 }
 
 }  // namespace
+
+FinalBundleAdjustmentOptions WithCaptureTimes(
+    FinalBundleAdjustmentOptions ba_options, bool offsets, bool line_delays,
+    const std::vector<CameraCaptureTime>& times) {
+  ba_options.estimate_time_offsets = offsets;
+  ba_options.estimate_line_delays = line_delays;
+  ba_options.initial_time_offsets_s.clear();
+  ba_options.initial_line_delays_s.clear();
+  for (const CameraCaptureTime& time : times) {
+    ba_options.initial_time_offsets_s.push_back(offsets ? time.time_offset_s
+                                                        : 0.0);
+    ba_options.initial_line_delays_s.push_back(
+        line_delays ? time.line_delay_s : 0.0);
+  }
+  return ba_options;
+}
+
+FinalBundleAdjustmentOptions WithCaptureTimes(
+    const FinalBundleAdjustmentOptions& ba_options,
+    const CaptureTimeModel& model) {
+  if (!model.computed ||
+      (!model.time_offsets_kept && !model.line_delays_kept)) {
+    return ba_options;
+  }
+  return WithCaptureTimes(ba_options, model.time_offsets_kept,
+                          model.line_delays_kept, model.cameras);
+}
+
+void SetCaptureTimeSigmas(const CalibrationUncertainty& uncertainty,
+                          std::vector<CameraCaptureTime>* times) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (size_t c = 0; c < times->size(); ++c) {
+    CameraCaptureTime& time = (*times)[c];
+    const bool computed = uncertainty.computed &&
+                          c < uncertainty.cameras.size() &&
+                          uncertainty.cameras[c].computed;
+    if (time.time_offset_estimated) {
+      time.time_offset_sigma_s =
+          computed ? uncertainty.cameras[c].time_offset_stddev_s : nan;
+    }
+    if (time.line_delay_estimated) {
+      time.line_delay_sigma_s =
+          computed ? uncertainty.cameras[c].line_delay_stddev_s : nan;
+    }
+  }
+}
 
 bool CaptureTimeModeFromName(const std::string& name, CaptureTimeMode* mode) {
   for (const CaptureTimeMode value :
@@ -166,6 +229,8 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
 
   const size_t num_cameras = dataset.cameras.size();
   model->cameras = summary.capture_times;
+  EstimateCaptureTimeSigmas(ba_options, want_offsets, want_shutter, dataset, result,
+                       &model->cameras, &model->sigma_error);
   model->time_offset_significant.assign(num_cameras, false);
   model->line_delay_significant.assign(num_cameras, false);
   bool any_offset = false, any_delay = false;
@@ -201,8 +266,9 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
                         !std::isfinite(time.line_delay_sigma_s));
     }
     message << "none significant (" << options.min_sigmas << " sigma, 1 ms"
-            << (sigmas_missing ? "; no sigma, so none can be: 1 keeps them"
-                               : "")
+            << (sigmas_missing ? "; no sigma (" + model->sigma_error +
+                                     "), so none can be: 1 keeps them"
+                               : std::string())
             << "): the calibration is the synchronized global-shutter one";
     model->rms_px = model->rms_without_px;
     model->message = message.str();
@@ -228,6 +294,9 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
       return true;
     }
     model->cameras = summary.capture_times;
+    EstimateCaptureTimeSigmas(ba_options, model->time_offsets_kept,
+                         model->line_delays_kept, dataset, result,
+                         &model->cameras, &model->sigma_error);
   }
   message << "kept: "
           << (model->time_offsets_kept && model->line_delays_kept

@@ -13,8 +13,10 @@
 //               hardware-triggered rig is synchronized to well below that);
 //   line delay: |rho_c| > min_sigmas sigma(rho_c) and |rho_c| * height_c >
 //               min_readout_s (the readout time of the whole image, 1 ms).
-// Without sigmas (ceres::Covariance found the Jacobian rank deficient, as
-// on the benchmark's 1dr runs with offsets, docs/time_model.md) nothing is
+// The sigmas are the calibration's uncertainty with the time model
+// (calibration_uncertainty.h: the larger of the noise and the
+// between-framesets estimate, the map, rig poses and intrinsics
+// marginalized). Without them (the uncertainty not computed) nothing is
 // significant: auto keeps nothing (`1` still keeps). A drop of the RMS is no
 // evidence on real data, whose residuals are correlated: on the real ring a
 // 5 % drop kept offsets of up to 10.6 ms that changed from one held-out
@@ -35,12 +37,14 @@
 // magnitude, which is all the adjustment needs.
 //
 // Without frameset times the model cannot run: auto and off change nothing,
-// on is an error. The time model's adjustment runs on Ceres' backend.
+// on is an error. The time model's adjustment runs on the final adjustment's
+// backend (both have the time parameters).
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/final_bundle_adjuster.h"
 
@@ -86,9 +90,29 @@ struct CaptureTimeModel {
   std::vector<bool> line_delay_significant;
   // The adjustment's RMS (pixels) with the time model, and today's.
   double rms_px = 0, rms_without_px = 0;
+  // Why the sigmas are NaN, when they are (the uncertainty's message).
+  std::string sigma_error;
   // One line: what was estimated and kept, and why.
   std::string message;
 };
+
+// ba_options with the time model of `times` (values per dataset camera):
+// the kinds asked for estimated, at those values (the rest 0).
+FinalBundleAdjustmentOptions WithCaptureTimes(
+    FinalBundleAdjustmentOptions ba_options, bool offsets, bool line_delays,
+    const std::vector<CameraCaptureTime>& times);
+// ba_options with the kinds `model` kept, at its values; unchanged when it
+// kept none: the adjustment whose result the calibration is (for its
+// uncertainty).
+FinalBundleAdjustmentOptions WithCaptureTimes(
+    const FinalBundleAdjustmentOptions& ba_options,
+    const CaptureTimeModel& model);
+
+// The sigmas of the estimated offsets and line delays of `times` from the
+// calibration's uncertainty with the time model (NaN where it was not
+// computed).
+void SetCaptureTimeSigmas(const CalibrationUncertainty& uncertainty,
+                          std::vector<CameraCaptureTime>* times);
 
 // The step above. `calibration` is today's final-adjustment result; it is
 // replaced by the time-model result when a kind is kept. `ba_options` the

@@ -145,20 +145,13 @@ bool SolveWithPruning(const FinalBundleAdjustmentOptions& options,
 
 }  // namespace
 
-bool AdjustRig(const FinalBundleAdjustmentOptions& given_options,
+bool AdjustRig(const FinalBundleAdjustmentOptions& options,
                const RigDataset& dataset, RigCalibration* calibration,
                FinalBundleAdjustmentSummary* summary) {
   const auto start_time = std::chrono::steady_clock::now();
   if (calibration == nullptr ||
-      !CheckInput(given_options, dataset, *calibration)) {
+      !CheckInput(options, dataset, *calibration)) {
     return false;
-  }
-  FinalBundleAdjustmentOptions options = given_options;
-  if (options.HasTimeModel() &&
-      options.bundle_solver != BundleSolverBackend::kCeres) {
-    LOG(INFO) << "Final bundle adjustment: the time model runs on Ceres' "
-                 "solver (the own solver has no time parameters)";
-    options.bundle_solver = BundleSolverBackend::kCeres;
   }
   RigAdjustment adjustment(options, dataset, *calibration);
   adjustment.RejectOutliers(/*prune_residuals=*/false);
@@ -185,12 +178,7 @@ bool AdjustRig(const FinalBundleAdjustmentOptions& given_options,
     result.num_iterations += relinearized.num_successful_steps +
                              relinearized.num_unsuccessful_steps;
     result.solver_report = relinearized.BriefReport();
-    result.capture_times =
-        adjustment.CaptureTimes(&result.capture_time_sigma_error);
-    if (!result.capture_time_sigma_error.empty()) {
-      LOG(WARNING) << "Final bundle adjustment: no sigma for the time model ("
-                   << result.capture_time_sigma_error << ")";
-    }
+    result.capture_times = adjustment.CaptureTimes();
   }
   adjustment.RejectMapOutliers();
   result.final_rms_px = adjustment.RmsError();

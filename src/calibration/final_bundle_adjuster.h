@@ -25,12 +25,9 @@
 // (a rolling shutter's line delay is observable for the reference camera
 // too). After the last solve the motion is recomputed once more and the
 // problem solved again, so that the result is a fixed point of the model.
-// The time parameters' sigmas are sigma_eff sqrt(diag((J^T J)^-1)) with
-// sigma_eff as in calibration_uncertainty.h (Huber's M-estimate scale of
-// the rig residuals), from ceres::Covariance over the whole problem.
-// The time model runs on Ceres' backend: with the own one selected it
-// switches to Ceres and says so in the log (the own solver's blocks are a
-// pose, a camera and a point per residual).
+// The time parameters are in their camera's block row of the reduced system
+// (with its intrinsics and cam_from_rig), on either backend; their sigmas
+// are the calibration's uncertainty's (calibration_uncertainty.h).
 //
 // Solver: the problem's own Levenberg-Marquardt
 // (src/solvers/bundle_levenberg_marquardt.h), which eliminates the refined
@@ -139,9 +136,10 @@ struct FinalBundleAdjustmentOptions {
 
 // One camera's capture timing from the adjustment's time model: offset
 // delta_c (seconds, the reference camera 0) and line delay rho_c (seconds
-// per row), with their 1-sigma uncertainties (NaN when the covariance could
-// not be computed), and whether each was estimated (else the value is the
-// one held).
+// per row), whether each was estimated (else the value is the one held),
+// and their 1-sigma uncertainties (AdjustRig leaves them 0; the capture-time
+// model, capture_time_model.h, sets them from the calibration's uncertainty,
+// NaN when it could not be computed).
 struct CameraCaptureTime {
   bool time_offset_estimated = false;
   double time_offset_s = 0, time_offset_sigma_s = 0;
@@ -164,10 +162,8 @@ struct FinalBundleAdjustmentSummary {
   int num_map_residuals = 0, num_map_outliers = 0;
   double map_initial_rms_px = 0, map_final_rms_px = 0;
   std::string solver_report;  // BriefReport of the last solve
-  // With a time model: per dataset camera (else empty); why the sigmas are
-  // missing, if they are.
+  // With a time model: per dataset camera (else empty).
   std::vector<CameraCaptureTime> capture_times;
-  std::string capture_time_sigma_error;
 };
 
 // Minimizes the objective above over the correspondences with

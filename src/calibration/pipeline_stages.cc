@@ -307,8 +307,11 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               const std::string& stage_name) {
   StageTimer stage(stage_name, options.print_progress, report);
   SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
+  // With the capture-time model's kept kinds once it ran (they are
+  // estimated again, from its values).
   const FinalBundleAdjustmentOptions ba_options =
-      FinalBundleAdjustmentOptionsFor(options, method, dataset);
+      WithCaptureTimes(FinalBundleAdjustmentOptionsFor(options, method, dataset),
+                       report->capture_time_model);
   // What was estimated of each camera's intrinsics in the whole pipeline:
   // the final adjustment's refinement (the known* methods estimate nothing
   // before it, the others hold the same parameters in every stage).
@@ -327,6 +330,16 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
   }
   stage.SetNumIterations(summary.num_iterations);
   report->final_rms_px = summary.final_rms_px;
+  if (ba_options.HasTimeModel()) {
+    // The new values; their sigmas: the uncertainty step's.
+    CaptureTimeModel& time_model = report->capture_time_model;
+    for (size_t c = 0; c < summary.capture_times.size(); ++c) {
+      time_model.cameras[c].time_offset_s =
+          summary.capture_times[c].time_offset_s;
+      time_model.cameras[c].line_delay_s = summary.capture_times[c].line_delay_s;
+    }
+    time_model.rms_px = summary.final_rms_px;
+  }
   if (options.print_progress) {
     std::cout << "  RMS " << summary.initial_rms_px << " -> "
               << summary.final_rms_px << " px over " << summary.num_residuals
@@ -389,9 +402,14 @@ void RunUncertaintyEstimation(const PipelineOptions& options,
                               const RigCalibration& calibration,
                               PipelineReport* report) {
   StageTimer stage("Uncertainty", options.print_progress, report);
+  // With the capture-time model's kept kinds: the uncertainty of the
+  // adjustment the calibration comes from.
   report->uncertainty = EstimateCalibrationUncertainty(
-      FinalBundleAdjustmentOptionsFor(options, method, dataset), dataset,
-      calibration);
+      WithCaptureTimes(FinalBundleAdjustmentOptionsFor(options, method, dataset),
+                       report->capture_time_model),
+      dataset, calibration);
+  SetCaptureTimeSigmas(report->uncertainty,
+                       &report->capture_time_model.cameras);
   for (const Diagnostic& diagnostic :
        UncertaintyDiagnostics(dataset, calibration, report->uncertainty)) {
     report->diagnostics.push_back(diagnostic);

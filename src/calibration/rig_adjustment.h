@@ -71,10 +71,9 @@ class RigAdjustment {
   void WriteTo(RigCalibration* calibration) const;
 
   // With the options' time model: per dataset camera its current offset
-  // and line delay and, after a solve, their sigmas (final_bundle_
-  // adjuster.h); on failure of the covariance the sigmas are NaN and
-  // `sigma_error` says why.
-  std::vector<CameraCaptureTime> CaptureTimes(std::string* sigma_error);
+  // and line delay, and whether each is estimated (their sigmas: the
+  // calibration's uncertainty, calibration_uncertainty.h).
+  std::vector<CameraCaptureTime> CaptureTimes() const;
 
  private:
   // One correspondence of one dataset image, with its cost and residual
@@ -106,9 +105,6 @@ class RigAdjustment {
   // With a time model: the frameset motions (frameset_motion.h) from the
   // current rig poses, before each solve.
   void UpdateFramesetMotions();
-  // sigma_eff^2 (calibration_uncertainty.h) of the rig observations at the
-  // current estimate, with `num_parameters` free parameters.
-  double EffectiveResidualVariance(int64_t num_parameters) const;
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
@@ -174,8 +170,6 @@ class RigAdjustment {
   std::vector<double> time_offsets_;
   std::vector<double> line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
-  // The parameter count of the last solve (for sigma_eff).
-  int64_t num_free_parameters_ = 0;
   LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;
   // The map images (empty unless refine_points and map images):

@@ -50,8 +50,6 @@ bool RigAdjustment::Solve(double function_tolerance,
           << summary->factorization_seconds << " s; reduced system "
           << summary->reduced_system_size << " unknowns, "
           << summary->num_points << " points";
-  num_free_parameters_ =
-      summary->reduced_system_size + 3 * static_cast<int64_t>(summary->num_points);
   if (!summary->IsSolutionUsable()) {
     LOG(ERROR) << "Final bundle adjustment failed: " << summary->message;
     return false;
@@ -225,8 +223,9 @@ void RigAdjustment::AddParameterBlocks(
                                  manifold, group);
       in_group = true;
     }
-    // The time model's blocks (Ceres' backend: groups do not apply). The
-    // reference camera's offset stays 0: it defines the rig's clock.
+    // The time model's blocks, in the camera's group: an observation still
+    // couples two block rows. The reference camera's offset stays 0: it
+    // defines the rig's clock.
     if (options_.estimate_time_offsets &&
         static_cast<int>(camera) != dataset_.reference_camera) {
       solver_->AddParameterBlock(&time_offsets_[camera], 1, nullptr, group);

@@ -24,8 +24,8 @@
 // theta (the model's kNumParams), delta_c (1), rho_c (1) and, when the point
 // is refined, X (3). A block the adjustment does not add (the reference
 // camera's delta, which is 0; rho when rolling shutter is off) is a
-// constant of the solver. Jacobians by automatic differentiation: the time
-// model runs on Ceres' backend only (final_bundle_adjuster.h).
+// constant of the solver. Jacobians by automatic differentiation (both
+// bundle solvers take them: bundle_solver.h).
 // A point that is not in front of the camera is an invalid evaluation.
 #pragma once
 

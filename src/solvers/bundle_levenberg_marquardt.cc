@@ -25,7 +25,10 @@ namespace {
 // The work is cut into this many chunks whatever the thread count, so that
 // sums over chunks (added in chunk order) do not depend on it.
 constexpr int kMaxNumChunks = 16;
-constexpr int kMaxParametersPerResidual = 4;
+// A residual's blocks: a pose, a cam_from_rig, intrinsics, with the final
+// adjustment's time model a capture-time offset and a line delay, and a
+// point.
+constexpr int kMaxParametersPerResidual = 6;
 // Ceres' defaults (LevenbergMarquardtStrategy, TrustRegionMinimizer).
 constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;
@@ -1659,13 +1662,6 @@ void BundleLevenbergMarquardt::Solve(BundleSolverSummary* summary) {
       return;
     }
   }
-}
-
-bool BundleLevenbergMarquardt::Variances(
-    const std::vector<const double*>& /*blocks*/,
-    std::vector<double>* /*variances*/, std::string* error) {
-  *error = "the own solver does not compute variances of single blocks";
-  return false;
 }
 
 }  // namespace rig_calibrator

@@ -4,9 +4,11 @@
 // fixed structure instead of Ceres' general one.
 //
 // Problem. Residual blocks of 2 rows, r_t(x), each a ceres::CostFunction
-// (analytic Jacobians: rig_reprojection_cost.h) over up to three "camera
-// side" parameter blocks (a pose, a cam_from_rig, intrinsics) and at most one
-// point (3 values), with a robust loss rho:
+// (analytic Jacobians: rig_reprojection_cost.h; automatic ones for the time
+// model's timed_rig_reprojection_cost.h) over up to five "camera side"
+// parameter blocks (a pose, a cam_from_rig, intrinsics, and with the final
+// adjustment's time model a capture-time offset and a line delay) and at
+// most one point (3 values), with a robust loss rho:
 //
 //   min_x  F(x) = 1/2 sum_t rho(|r_t(x)|^2).
 //
@@ -98,9 +100,6 @@ class BundleLevenbergMarquardt final : public BundleSolver {
 
   // After a failure midway, the values are the last accepted estimate.
   void Solve(BundleSolverSummary* summary) override;
-  // Not available (the time model runs on Ceres' backend): false.
-  bool Variances(const std::vector<const double*>& blocks,
-                 std::vector<double>* variances, std::string* error) override;
 
   // The Gauss-Newton reduced system at the current values (see the top of
   // the file): J the Jacobian of the residuals with rho(s) = s, in the

@@ -117,17 +117,6 @@ class BundleSolver {
   // estimate; after a failure the values are the backend's last accepted
   // ones or the initial ones, and are not to be used).
   virtual void Solve(BundleSolverSummary* summary) = 0;
-
-  // The variances diag((J^T J)^-1) of one-value parameter blocks, J the
-  // Jacobian of the active residuals (without loss) over every refined block
-  // at the current values: the covariance of the final adjustment's time
-  // model (final_bundle_adjuster.h), which the caller scales by the
-  // residuals' effective variance. Ceres' backend only (ceres::Covariance):
-  // the own solver's reduced system has no time parameters. False with
-  // `error` when not available or J is rank deficient.
-  virtual bool Variances(const std::vector<const double*>& blocks,
-                         std::vector<double>* variances,
-                         std::string* error) = 0;
 };
 
 enum class BundleSolverBackend { kOwn, kCeres };

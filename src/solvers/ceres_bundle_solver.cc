@@ -121,43 +121,6 @@ void CeresBundleSolver::BuildProblem(
   }
 }
 
-bool CeresBundleSolver::Variances(const std::vector<const double*>& blocks,
-                                  std::vector<double>* variances,
-                                  std::string* error) {
-  ceres::Problem problem(NonOwningProblemOptions());
-  std::shared_ptr<ceres::ParameterBlockOrdering> ordering;
-  BuildProblem(&problem, &ordering, nullptr);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (const double* block : blocks) {
-    if (!problem.HasParameterBlock(block) ||
-        problem.ParameterBlockSize(block) != 1 ||
-        problem.IsParameterBlockConstant(block)) {
-      *error = "a block of the variances is not a free one-value block";
-      return false;
-    }
-    pairs.emplace_back(block, block);
-  }
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::SPARSE_QR;
-  covariance_options.apply_loss_function = false;
-  covariance_options.num_threads =
-      options_.num_threads > 0
-          ? options_.num_threads
-          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  ceres::Covariance covariance(covariance_options);
-  if (!covariance.Compute(pairs, &problem)) {
-    *error = "the Jacobian is rank deficient (ceres::Covariance failed)";
-    return false;
-  }
-  variances->clear();
-  for (const double* block : blocks) {
-    double variance = 0;
-    covariance.GetCovarianceBlock(block, block, &variance);
-    variances->push_back(variance);
-  }
-  return true;
-}
-
 void CeresBundleSolver::Solve(BundleSolverSummary* summary) {
   using Termination = BundleSolverSummary::Termination;
   const auto start_time = std::chrono::steady_clock::now();

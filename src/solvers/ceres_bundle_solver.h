@@ -55,10 +55,6 @@ class CeresBundleSolver final : public BundleSolver {
   void SetFunctionTolerance(double tolerance) override;
   // After a failure, the values are the initial ones (Ceres restores them).
   void Solve(BundleSolverSummary* summary) override;
-  // ceres::Covariance (SPARSE_QR, without the loss) over the problem Solve
-  // builds, at the current values.
-  bool Variances(const std::vector<const double*>& blocks,
-                 std::vector<double>* variances, std::string* error) override;
 
  private:
   struct Block {

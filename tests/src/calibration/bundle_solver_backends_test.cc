@@ -4,8 +4,9 @@
 // adjustment (AdjustRadialRig) and the final one (RigAdjustment, the
 // problem AdjustRig solves) with points fixed, points refined, map images,
 // the map adjusted in a free gauge, wrong matches under the Cauchy loss with
-// a pruning round (inactive residual blocks, held points), and each camera
-// model family. The data come from the synthetic generator
+// a pruning round (inactive residual blocks, held points), each camera
+// model family, and the time model (capture-time offsets and line delays,
+// automatic Jacobians). The data come from the synthetic generator
 // (synthetic_rig.h), the start is the truth perturbed.
 //
 // The two backends take the same steps (the own solver follows Ceres'
@@ -58,6 +59,7 @@ constexpr double kFunctionTolerance = 0;
 // One backend's result on one problem.
 struct BackendRun {
   RigCalibration calibration;
+  std::vector<CameraCaptureTime> capture_times;  // with a time model
   double final_cost = 0;  // F of the last solve
   int iterations = 0;     // over all solves
   double seconds = 0;     // of the solves (radial: of AdjustRadialRig)
@@ -196,6 +198,17 @@ void ExpectSameMinimum(const std::string& kind, const BackendRun& own,
   row.kind = kind;
   row.cost_ratio = own.final_cost / ceres.final_cost;
   row.difference = Compare(own.calibration, ceres.calibration);
+  // Time offsets (seconds) and line delays as readouts of 1000 rows
+  // (seconds).
+  for (size_t c = 0; c < ceres.capture_times.size(); ++c) {
+    const CameraCaptureTime& a = own.capture_times[c];
+    const CameraCaptureTime& b = ceres.capture_times[c];
+    row.difference.Add(std::abs(a.time_offset_s - b.time_offset_s),
+                       "time offset");
+    row.difference.Add(1000 * std::abs(a.line_delay_s - b.line_delay_s),
+                       "line delay");
+  }
+  EXPECT_EQ(own.capture_times.size(), ceres.capture_times.size());
   row.time_ratio = own.seconds / ceres.seconds;
   row.own_iterations = own.iterations;
   row.ceres_iterations = ceres.iterations;
@@ -346,6 +359,7 @@ BackendRun RunFinalAdjustment(const SyntheticRig& rig,
   run.final_cost = summary.final_cost;
   run.calibration = start;
   adjustment.WriteTo(&run.calibration);
+  if (options.HasTimeModel()) run.capture_times = adjustment.CaptureTimes();
   if (options.refine_points && !adjustment.HasFixedPoints()) {
     if (options.refine_map) {
       EXPECT_TRUE(AnchorMapImagesToMap(rig.dataset, &run.calibration));
@@ -508,6 +522,39 @@ TEST(BundleSolverBackendsTest, FinalAdjustmentPinhole) {
   FinalBundleAdjustmentOptions options;
   options.refine_points = true;
   CompareFinalAdjustment("final BA, ring5 as PINHOLE", rig, options);
+}
+
+TEST(BundleSolverBackendsTest, FinalAdjustmentTimeModel) {
+  // ring5 at 15 Hz with capture-time offsets in +-50 ms and line delays of
+  // 20-30 us per row; the offsets start 2 ms off, the line delays 10 % (the
+  // rest as every test here: the truth perturbed).
+  SyntheticRigOptions rig_options;
+  rig_options.preset = RigPreset::kRing5;
+  rig_options.num_framesets = 12;
+  rig_options.points_per_image = 60;
+  rig_options.noise_px = 0.5;
+  rig_options.outlier_ratio = 0;
+  rig_options.missing_image_ratio = 0.1;
+  rig_options.frameset_rate_hz = 15;
+  rig_options.max_time_offset_s = 0.05;
+  rig_options.min_line_delay_s = 20e-6;
+  rig_options.max_line_delay_s = 30e-6;
+  rig_options.seed = 7;
+  const SyntheticRig rig = GenerateSyntheticRig(rig_options);
+  // Points held: at 15 Hz consecutive framesets see a point from nearly the
+  // same place, and such points creep along their rays for 1000 iterations
+  // in both backends.
+  FinalBundleAdjustmentOptions options;
+  options.refine_points = false;
+  options.estimate_time_offsets = true;
+  options.estimate_line_delays = true;
+  for (size_t c = 0; c < rig.truth.time_offsets_s.size(); ++c) {
+    options.initial_time_offsets_s.push_back(
+        c == 0 ? 0.0 : rig.truth.time_offsets_s[c] + 2e-3);
+    options.initial_line_delays_s.push_back(0.9 * rig.truth.line_delays_s[c]);
+  }
+  CompareFinalAdjustment("final BA, time model (offsets, line delays), ring5",
+                         rig, options);
 }
 
 // The comparison can fail: a Ceres solve stopped after 2 iterations is
