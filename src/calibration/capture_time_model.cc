@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -23,6 +24,20 @@ double CalibrationRms(const RigCalibration& calibration) {
     count += image.num_inliers;
   }
   return count > 0 ? std::sqrt(sum / count) : 0;
+}
+
+// The median interval between consecutive framesets (seconds), 0 with
+// fewer than two.
+double MedianFramesetInterval(const std::vector<double>& times_s) {
+  std::vector<double> intervals;
+  for (size_t f = 1; f < times_s.size(); ++f) {
+    intervals.push_back(times_s[f] - times_s[f - 1]);
+  }
+  if (intervals.empty()) return 0;
+  const size_t middle = intervals.size() / 2;
+  std::nth_element(intervals.begin(), intervals.begin() + middle,
+                   intervals.end());
+  return intervals[middle];
 }
 
 // Beyond the floor and min_sigmas sigma; never without a sigma (the
@@ -203,6 +218,27 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
       options.initial_time_offsets_s.size() != dataset.cameras.size()) {
     *error = "the capture-time model's start offsets are not one per camera";
     return false;
+  }
+  const double interval = MedianFramesetInterval(dataset.frameset_times_s);
+  if (interval > options.max_frameset_interval_s) {
+    std::ostringstream why;
+    why << "the framesets are " << std::setprecision(3) << interval
+        << " s apart (median), more than "
+        << options.max_frameset_interval_s
+        << " s: the rig's motion between them, which the model needs at "
+           "each camera's own instant, is not known";
+    if (!offsets_on && !shutter_on) {
+      model->computed = true;
+      model->rms_without_px = model->rms_px = CalibrationRms(*calibration);
+      model->message = "not estimated: " + why.str() +
+                       "; the calibration is the synchronized global-shutter "
+                       "one (1 estimates anyway)";
+      LOG(INFO) << "Capture-time model: " << model->message;
+      return true;
+    }
+    LOG(WARNING) << "Capture-time model: " << why.str()
+                 << "; estimated because it was asked for (1): treat the "
+                    "offsets and line delays with suspicion";
   }
   const std::vector<double> start_offsets =
       !want_offsets ? std::vector<double>()

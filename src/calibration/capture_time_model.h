@@ -37,7 +37,18 @@
 // magnitude, which is all the adjustment needs.
 //
 // Without frameset times the model cannot run: auto and off change nothing,
-// on is an error. The time model's adjustment runs on the final adjustment's
+// on is an error. Nor can it follow the rig between framesets that are far
+// apart in time: the motion model (frameset_motion.h) is a polynomial
+// through the five nearest frameset poses, which follows motion up to a
+// fraction of the frameset rate (at 5 Hz the synthetic walk's 2.3 Hz bob is
+// not followed); a hand-held or vehicle rig moves at 1-2 Hz (gait, sway).
+// With framesets further apart than max_frameset_interval_s (median) the
+// rig's velocity at each frameset is a guess, and the offsets absorb
+// whatever differs between framesets: on the real 5-camera ring (framesets
+// 5.5 s apart) auto kept offsets of up to 10.6 ms with sigmas of 0.1-0.5
+// ms that changed by up to 16 ms from one held-out split to the next
+// (docs/time_model.md). auto then does not estimate (and says why); on
+// estimates anyway and warns. The time model's adjustment runs on the final adjustment's
 // backend (both have the time parameters).
 #pragma once
 
@@ -63,6 +74,9 @@ struct CaptureTimeModelOptions {
   double min_sigmas = 3.0;
   double min_offset_s = 1e-3;
   double min_readout_s = 1e-3;
+  // Above this median interval between consecutive framesets auto does not
+  // run (see the top).
+  double max_frameset_interval_s = 0.5;
   // Inliers of the start: within this reprojection error of today's result
   // (the pipeline sets the final adjustment's own threshold).
   double inlier_max_error_px = 10.0;
@@ -77,7 +91,8 @@ struct CaptureTimeModelOptions {
 // "capture_time_model").
 struct CaptureTimeModel {
   // False when the step did not run (no frameset times, or both kinds off):
-  // nothing below is set.
+  // nothing below is set. With framesets too far apart for auto (see the
+  // top) it is true with only `message` and the RMS set.
   bool computed = false;
   // Which kinds the calibration now models (false: not estimated, or
   // estimated and dropped by auto).

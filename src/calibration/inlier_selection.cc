@@ -1,5 +1,7 @@
 #include "src/calibration/inlier_selection.h"
 
+#include <unordered_map>
+
 #include "src/geometry/radial_error.h"
 
 namespace rig_calibrator {
@@ -51,11 +53,16 @@ void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
 
 void SelectFullInliers(const RigDataset& dataset, double max_error_px,
                        RigCalibration* calibration) {
+  const std::unordered_map<int64_t, Eigen::Vector3d>& refined =
+      calibration->refined_points3D;
   SelectInliers(dataset, calibration,
                 [&](const colmap::Camera& camera, const Rigid3d& cam_from_world,
                     const Correspondence& correspondence) {
+                  const auto point = refined.find(correspondence.point3D_id);
                   const Eigen::Vector3d point_cam =
-                      cam_from_world * correspondence.point3D;
+                      cam_from_world * (point != refined.end()
+                                            ? point->second
+                                            : correspondence.point3D);
                   return point_cam.z() > 1e-9 &&
                          (camera.WorldToImage(point_cam.hnormalized()) -
                           correspondence.point2D)

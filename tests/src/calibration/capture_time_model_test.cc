@@ -352,6 +352,45 @@ TEST(CaptureTimeModel, SynchronizedGlobalShutterAutoKeepsNothing) {
   EXPECT_EQ(automatic.report.final_rms_px, off.report.final_rms_px);
 }
 
+// Framesets further apart than max_frameset_interval_s: auto does not
+// estimate and says why, the calibration unchanged; 1 estimates anyway. The
+// data are the 15 Hz ring with offsets, its frameset times stretched 10x
+// (0.67 s apart): the motion between framesets is then not what the times
+// say, as on a real rig whose framesets are seconds apart.
+TEST(CaptureTimeModel, FramesetsFarApartAutoDoesNotEstimate) {
+  SyntheticRigOptions options = TimedRingOptions(30, 40, kRateHz);
+  options.max_time_offset_s = 0.05;
+  SyntheticRig rig = GenerateSyntheticRig(options);
+  SetKnownIntrinsics(&rig);
+  for (double& time : rig.dataset.frameset_times_s) time *= 10;
+  const RigCalibration start = testing::CalibrationAtTruth(rig);
+  FinalBundleAdjustmentOptions ba;
+  ba.num_threads = 2;
+  CaptureTimeModelOptions model_options;
+  RigCalibration calibration = start;
+  CaptureTimeModel model;
+  std::string error;
+  ASSERT_TRUE(AdjustRigWithCaptureTimeModel(model_options, ba, rig.dataset,
+                                            &calibration, &model, &error));
+  std::cout << model.message << std::endl;
+  EXPECT_TRUE(model.computed);
+  EXPECT_FALSE(model.time_offsets_kept);
+  EXPECT_FALSE(model.line_delays_kept);
+  EXPECT_TRUE(model.cameras.empty());
+  EXPECT_NE(model.message.find("0.667 s apart"), std::string::npos)
+      << model.message;
+  for (size_t c = 0; c < 5; ++c) {
+    EXPECT_EQ(calibration.cameras[c].Params(), start.cameras[c].Params());
+  }
+  model_options.time_offsets = CaptureTimeMode::kOn;
+  model_options.rolling_shutter = CaptureTimeMode::kOff;
+  ASSERT_TRUE(AdjustRigWithCaptureTimeModel(model_options, ba, rig.dataset,
+                                            &calibration, &model, &error))
+      << error;
+  EXPECT_TRUE(model.time_offsets_kept);
+  EXPECT_EQ(model.cameras.size(), 5u);
+}
+
 // Asked for without frameset times: an error naming the cause; auto: the
 // step does not run.
 TEST(CaptureTimeModel, WithoutFramesetTimesOnIsAnErrorAutoChangesNothing) {
