@@ -18,12 +18,15 @@
 #   BENCHMARK_CAMERAS         cameras on the ring (default 10)
 #   BENCHMARK_THREADS         --RigCalibrator.num_threads (default -1: all)
 #   BENCHMARK_TIME_MODEL      1: the rig is unsynchronized with rolling
-#                             shutters (framesets at 5 Hz, the rig at
+#                             shutters (framesets at 15 Hz, the rig at
 #                             1.5 m/s and 60 deg/s, offsets in +-50 ms, line
 #                             delays 20-30 us/row), the frameset times are
 #                             given (the names are frameset indices:
-#                             timestamp_unit_s 0.2), and a third run has the
-#                             time model off: the time model's cost
+#                             timestamp_unit_s 1/15), and a third run has
+#                             the time model off: the time model's cost.
+#                             15 Hz: at 5 Hz the synthetic walk's 2.3 Hz
+#                             bob aliases (docs/time_model.md) and at 500
+#                             framesets the model check flags a camera
 set -euo pipefail
 
 log_tag=benchmark_command
@@ -43,10 +46,10 @@ timed_data=()
 timed_options=()
 if [[ "$time_model" == 1 ]]; then
   runs+=(time_model_off)
-  timed_data=(--frameset_rate_hz 5 --speed_m_s 1.5 --max_turn_rate_deg_s 60
+  timed_data=(--frameset_rate_hz 15 --speed_m_s 1.5 --max_turn_rate_deg_s 60
               --max_time_offset_ms 50 --line_delay_us 20,30)
   timed_options=(--RigCalibrator.timestamp_tolerance 0.5
-                 --RigCalibrator.timestamp_unit_s 0.2)
+                 --RigCalibrator.timestamp_unit_s 0.0666666666666667)
 fi
 [[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 [[ -x /usr/bin/time ]] || die "/usr/bin/time is needed (apt-get install time)"

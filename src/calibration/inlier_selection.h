@@ -5,6 +5,8 @@
 // posed by the other cameras.
 #pragma once
 
+#include <vector>
+
 #include "src/rig/rig_dataset.h"
 
 namespace rig_calibrator {
@@ -22,7 +24,15 @@ void SelectRadialInliers(const RigDataset& dataset, double max_error_px,
 // (calibration->refined_points3D), else the map's: a refined map can have
 // moved away from the input's (on the real EuRoC pair's self-calibrated map
 // every rig observation but one was beyond 10 px of the input points).
+// With capture times (the final adjustment's time model: per dataset camera
+// its offset and line delay in seconds, seconds per row; empty: 0) the
+// point is taken in the rig frame of its row's instant (frameset_motion.h,
+// the motion from the current rig poses and the dataset's frameset times):
+// an unsynchronized camera's correct correspondences are tens of pixels
+// from the synchronized projection.
 void SelectFullInliers(const RigDataset& dataset, double max_error_px,
-                       RigCalibration* calibration);
+                       RigCalibration* calibration,
+                       const std::vector<double>& time_offsets_s = {},
+                       const std::vector<double>& line_delays_s = {});
 
 }  // namespace rig_calibrator

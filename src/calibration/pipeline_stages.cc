@@ -306,12 +306,14 @@ bool RunFinalBundleAdjustment(const PipelineOptions& options,
                               PipelineReport* report,
                               const std::string& stage_name) {
   StageTimer stage(stage_name, options.print_progress, report);
-  SelectFullInliers(dataset, options.upgrade.max_error_px, calibration);
   // With the capture-time model's kept kinds once it ran (they are
-  // estimated again, from its values).
+  // estimated again, from its values), and the inliers at their instants.
   const FinalBundleAdjustmentOptions ba_options =
       WithCaptureTimes(FinalBundleAdjustmentOptionsFor(options, method, dataset),
                        report->capture_time_model);
+  SelectFullInliers(dataset, options.upgrade.max_error_px, calibration,
+                    ba_options.initial_time_offsets_s,
+                    ba_options.initial_line_delays_s);
   // What was estimated of each camera's intrinsics in the whole pipeline:
   // the final adjustment's refinement (the known* methods estimate nothing
   // before it, the others hold the same parameters in every stage).
