@@ -50,6 +50,14 @@
 //  4. The profile on a grid of coarse_step_s over [-search_range_s,
 //     search_range_s], then golden-section search within one grid step of the
 //     best point down to tolerance_s.
+//  5. When the residuals at that offset are larger than the scale (median
+//     angle m > b: orientations much noisier than the options assume, e.g.
+//     rolling-shutter fisheye images, 0.5-0.6 deg on the rendered helmet),
+//     steps 3-4 again with b = 3 m, so that the right offsets' samples are
+//     inliers of the loss and the profile is not flat for lack of them.
+//     (Not for m a little below b: a larger scale down-weights wrong
+//     orientations less, and at 0.05 deg of noise b = 2 m doubled the
+//     errors of the noisy test.)
 //
 // Found when n >= min_framesets, the minimum is inside the search range
 // (not within one step of its bounds), and the profile at its minimum is at
@@ -98,7 +106,7 @@ struct RotationTimeOffsetOptions {
   double tolerance_s = 1e-6;
   // Cauchy scale b (about 2-5 times a localization's rotation noise: an
   // offset error of 5 ms at 60 deg/s turns the rig by 0.3 deg, outside the
-  // loss's flat part).
+  // loss's flat part); raised to the data's own scale by step 5.
   double loss_scale_rad = 0.2 * M_PI / 180;
   // Chord speeds above this are jumps of wrong localizations.
   double max_angular_speed_rad_s = M_PI;
