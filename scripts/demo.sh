@@ -30,6 +30,9 @@
 #   DEMO_CAMERA_MODEL  --RigCalibrator.camera_model: auto (default, the
 #                    command's default), "true" (the rendered rig's true
 #                    models), or any value the option takes
+#   DEMO_CALIBRATION_OPTIONS  more options of `colmap rig_calibrator`,
+#                    split at spaces, e.g. "--RigCalibrator.time_offsets 1
+#                    --RigCalibrator.rolling_shutter 1"
 #   DEMO_SKIP_BUILD  1: use the built tree as it is
 #   RIG_CALIBRATOR_BUILD_DIR, COLMAP, MAP_*, RIG_*: see scripts/build.sh,
 #   scripts/build_map.sh and scripts/calibrate_rig.sh
@@ -45,6 +48,7 @@ seed="${DEMO_SEED:-0}"
 num_map_images="${DEMO_MAP_IMAGES:-60}"
 num_framesets="${DEMO_FRAMESETS:-20}"
 camera_model="${DEMO_CAMERA_MODEL:-auto}"
+read -r -a calibration_options <<< "${DEMO_CALIBRATION_OPTIONS:-}"
 # A folder this demo wrote before (it holds the marker file) is replaced; any
 # other non-empty folder is left alone.
 marker=".rig_calibrator_demo"
@@ -105,7 +109,7 @@ run_step "map (colmap)" env MAP_MAX_FEATURES="${MAP_MAX_FEATURES:-2048}" \
 run_step "calibration (colmap + rig_calibrator)" \
   bash "$repo/scripts/calibrate_rig.sh" "$out/map/database.db" "$out/map/sparse/0" \
   "$dataset/rig_images" "$out/rig" --RigCalibrator.camera_model "$camera_model" \
-  "${grouping[@]}"
+  "${grouping[@]}" "${calibration_options[@]}"
 
 run_step "evaluation" "$colmap_extended" rig_calibrator evaluate \
   --reference_path "$truth/rig_config.json" \

@@ -10,6 +10,7 @@
 
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/inlier_selection.h"
+#include "src/calibration/time_offsets_from_rotations.h"
 
 namespace rig_calibrator {
 namespace {
@@ -48,16 +49,16 @@ bool Significant(double value, double sigma, double min_value,
          std::abs(value) > options.min_sigmas * sigma;
 }
 
-// The start offsets: the capture-timing estimate of the observable cameras.
-std::vector<double> EstimatedStartOffsets(const CaptureTimeModelOptions& options,
-                                          const RigDataset& dataset,
-                                          const RigCalibration& calibration) {
+// The capture-timing estimate of camera c's offset, if observable, else 0.
+std::vector<double> CaptureTimingStartOffsets(
+    const CaptureTimeModelOptions& options, const RigDataset& dataset,
+    const RigCalibration& calibration) {
   std::vector<double> offsets(dataset.cameras.size(), 0.0);
   const CaptureTiming timing = MeasureCaptureTiming(
       dataset, calibration, CalibrationUncertainty(), options.start_estimate);
   if (!timing.error.empty()) {
-    LOG(INFO) << "Capture-time model: offsets start at 0 (" << timing.error
-              << ")";
+    LOG(INFO) << "Capture-time model: no capture-timing start ("
+              << timing.error << ")";
     return offsets;
   }
   for (size_t c = 0; c < timing.offsets.size(); ++c) {
@@ -83,6 +84,60 @@ void EstimateCaptureTimeSigmas(const FinalBundleAdjustmentOptions& ba_options,
       result);
   *error = uncertainty.computed ? "" : uncertainty.message;
   SetCaptureTimeSigmas(uncertainty, times);
+}
+
+// The start offsets (see the header): from the images' own orientations
+// where found, else from the capture-timing estimate.
+std::vector<double> EstimatedStartOffsets(const CaptureTimeModelOptions& options,
+                                          const RigDataset& dataset,
+                                          const RigCalibration& calibration) {
+  const size_t num_cameras = dataset.cameras.size();
+  RotationTimeOffsetProblem problem;
+  problem.frameset_times_s = dataset.frameset_times_s;
+  problem.reference_camera = dataset.reference_camera;
+  problem.cam_from_world.assign(
+      num_cameras, std::vector<std::optional<Eigen::Quaterniond>>(
+                       dataset.frameset_names.size()));
+  for (size_t i = 0; i < dataset.images.size(); ++i) {
+    const std::optional<Rigid3d>& pose =
+        calibration.images[i].single_image_cam_from_world;
+    if (!pose) continue;
+    problem.cam_from_world[dataset.images[i].camera_index]
+                          [dataset.images[i].frameset_index] = pose->rotation;
+  }
+  std::vector<RotationTimeOffset> from_rotations;
+  std::string error;
+  if (!EstimateTimeOffsetsFromRotations(problem, options.rotation_start,
+                                        &from_rotations, &error)) {
+    LOG(INFO) << "Capture-time model: no start from the orientations ("
+              << error << ")";
+    from_rotations.assign(num_cameras, RotationTimeOffset());
+  }
+  std::vector<double> offsets(num_cameras, 0.0);
+  std::vector<double> timing;
+  for (size_t c = 0; c < num_cameras; ++c) {
+    if (static_cast<int>(c) == dataset.reference_camera) continue;
+    const RotationTimeOffset& rotation = from_rotations[c];
+    if (rotation.found) {
+      offsets[c] = rotation.offset_s;
+      LOG(INFO) << "Capture-time model: " << dataset.cameras[c].name
+                << " starts at " << offsets[c] * 1e3
+                << " ms (its images' orientations, " << rotation.num_framesets
+                << " framesets, median residual "
+                << rotation.median_residual_rad * 180 / M_PI << " deg)";
+      continue;
+    }
+    if (timing.empty()) {
+      timing = CaptureTimingStartOffsets(options, dataset, calibration);
+    }
+    offsets[c] = timing[c];
+    LOG(INFO) << "Capture-time model: " << dataset.cameras[c].name
+              << " starts at " << offsets[c] * 1e3
+              << " ms (the capture-timing estimate; not from the "
+                 "orientations: "
+              << rotation.diagnosis << ")";
+  }
+  return offsets;
 }
 
 // The time-model adjustment from `start` (today's parameters, its inliers

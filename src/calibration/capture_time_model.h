@@ -30,11 +30,17 @@
 // Start. The adjustment starts from today's result (its parameters, and
 // the inliers re-selected within inlier_max_error_px of it, as the final
 // adjustment's own start), the line delays at 0, the offsets at
-// initial_time_offsets_s when given, else at the capture-timing step's
-// estimate from each image's own pose (capture_timing.h) for the cameras it
-// finds observable, else 0. That estimate is biased toward 0 (today's
-// intrinsics absorbed part of the motion) but has the right sign and
-// magnitude, which is all the adjustment needs.
+// initial_time_offsets_s when given, else per camera at the offset that
+// the orientations of its images' single-image localizations give against
+// the reference camera's (time_offsets_from_rotations.h). Those rotations
+// depend neither on the intrinsics nor on synchronization (for 1dr, the
+// default, they need only the principal point), so the start needs no
+// synchronization, unlike the capture-timing estimate from each image's pose
+// with today's intrinsics (capture_timing.h), which is biased toward 0
+// (today's intrinsics absorbed part of the motion). That estimate (for the
+// cameras it finds observable, else 0) is the start only of the cameras
+// whose orientations give no offset (a rig that hardly turns, too few
+// framesets).
 //
 // Without frameset times the model cannot run: auto and off change nothing,
 // on is an error. Nor can it follow the rig between framesets that are far
@@ -58,6 +64,7 @@
 #include "src/calibration/calibration_uncertainty.h"
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/final_bundle_adjuster.h"
+#include "src/calibration/time_offsets_from_rotations.h"
 
 namespace rig_calibrator {
 
@@ -83,7 +90,9 @@ struct CaptureTimeModelOptions {
   // Start offsets per dataset camera (reference 0); empty: from the
   // capture-timing estimate (see the top).
   std::vector<double> initial_time_offsets_s;
-  // The capture-timing estimate of the start.
+  // The start from the images' orientations, and the capture-timing
+  // estimate where it finds none.
+  RotationTimeOffsetOptions rotation_start;
   CaptureTimingOptions start_estimate;
 };
 

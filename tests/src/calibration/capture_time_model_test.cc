@@ -196,7 +196,9 @@ TEST(CaptureTimeModel, ExactDataOffsetsFromTheTruth) {
 
 // The same exact data through the pipeline's step: today's adjustment (no
 // time model) from the truth's intrinsics, then the time model from the
-// capture-timing estimate of the offsets (on), not from the truth.
+// estimated start (on), not from the truth. CalibrationAtTruth has no
+// single-image localizations, so no camera's start comes from the
+// orientations: this is the capture-timing fallback's start.
 TEST(CaptureTimeModel, ExactDataOffsetsFromTheEstimatorStart) {
   SyntheticRigOptions options = Exact(TimedRingOptions(60, 40, kRateHz));
   options.max_time_offset_s = 0.05;
