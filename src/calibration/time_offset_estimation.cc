@@ -280,28 +280,15 @@ RigTrajectory BuildRigTrajectory(
     const std::vector<double>& times,
     const std::vector<std::optional<Rigid3d>>& reference,
     const std::vector<char>& is_knot, double max_gap) {
-  RigTrajectory trajectory;
-  std::vector<double> piece_times;
-  std::vector<Rigid3d> piece_poses;
-  auto close_piece = [&]() {
-    PoseTrajectory piece;
-    std::string unused;
-    if (piece_times.size() >= 2 &&
-        PoseTrajectory::Create(piece_times, piece_poses, &piece, &unused)) {
-      trajectory.pieces.push_back(std::move(piece));
-    }
-    piece_times.clear();
-    piece_poses.clear();
-  };
+  std::vector<double> knot_times;
+  std::vector<Rigid3d> knots;
   for (size_t f = 0; f < times.size(); ++f) {
     if (!is_knot[f]) continue;
-    if (!piece_times.empty() && times[f] - piece_times.back() > max_gap) {
-      close_piece();
-    }
-    piece_times.push_back(times[f]);
-    piece_poses.push_back(reference[f]->Inverse());  // world_from_rig
+    knot_times.push_back(times[f]);
+    knots.push_back(reference[f]->Inverse());  // world_from_rig
   }
-  close_piece();
+  RigTrajectory trajectory;
+  trajectory.pieces = PiecewisePoseTrajectories(knot_times, knots, max_gap);
   return trajectory;
 }
 

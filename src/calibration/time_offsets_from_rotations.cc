@@ -111,29 +111,16 @@ OrientationPieces BuildOrientationPieces(
     const std::vector<double>& times,
     const std::vector<std::optional<Eigen::Quaterniond>>& reference,
     const std::vector<char>& kept, double max_gap) {
-  OrientationPieces result;
-  std::vector<double> piece_times;
-  std::vector<Rigid3d> piece_poses;
-  auto close_piece = [&]() {
-    PoseTrajectory piece;
-    std::string unused;
-    if (piece_times.size() >= 2 &&
-        PoseTrajectory::Create(piece_times, piece_poses, &piece, &unused)) {
-      result.pieces.push_back(std::move(piece));
-    }
-    piece_times.clear();
-    piece_poses.clear();
-  };
+  std::vector<double> knot_times;
+  std::vector<Rigid3d> knots;
   for (size_t f = 0; f < times.size(); ++f) {
     if (!kept[f]) continue;
-    if (!piece_times.empty() && times[f] - piece_times.back() > max_gap) {
-      close_piece();
-    }
-    piece_times.push_back(times[f]);
+    knot_times.push_back(times[f]);
     // world_from_reference, at the origin: only the rotation is used.
-    piece_poses.emplace_back(reference[f]->conjugate(), Eigen::Vector3d::Zero());
+    knots.emplace_back(reference[f]->conjugate(), Eigen::Vector3d::Zero());
   }
-  close_piece();
+  OrientationPieces result;
+  result.pieces = PiecewisePoseTrajectories(knot_times, knots, max_gap);
   return result;
 }
 

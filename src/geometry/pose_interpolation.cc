@@ -197,4 +197,28 @@ PoseTrajectory::State PoseTrajectory::Evaluate(double t) const {
   return EvaluateSegment(segment, t);
 }
 
+std::vector<PoseTrajectory> PiecewisePoseTrajectories(
+    const std::vector<double>& times_s, const std::vector<Rigid3d>& poses,
+    double max_gap_s) {
+  std::vector<PoseTrajectory> pieces;
+  size_t first = 0;
+  for (size_t k = 1; k <= times_s.size(); ++k) {
+    if (k < times_s.size() && times_s[k] - times_s[k - 1] <= max_gap_s) {
+      continue;
+    }
+    // Knots [first, k) are one piece.
+    PoseTrajectory piece;
+    std::string unused;
+    if (k - first >= 2 &&
+        PoseTrajectory::Create(
+            std::vector<double>(times_s.begin() + first, times_s.begin() + k),
+            std::vector<Rigid3d>(poses.begin() + first, poses.begin() + k),
+            &piece, &unused)) {
+      pieces.push_back(std::move(piece));
+    }
+    first = k;
+  }
+  return pieces;
+}
+
 }  // namespace rig_calibrator

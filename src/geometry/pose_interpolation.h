@@ -97,4 +97,12 @@ class PoseTrajectory {
   std::vector<Eigen::Vector3d> velocities_;           // v_i
 };
 
+// Knots (times strictly increasing, world_from_body poses) cut where two
+// consecutive knots are more than max_gap_s apart (a gap the interpolation
+// should not bridge), each piece of two knots or more interpolated; a lone
+// knot makes no piece.
+std::vector<PoseTrajectory> PiecewisePoseTrajectories(
+    const std::vector<double>& times_s, const std::vector<Rigid3d>& poses,
+    double max_gap_s);
+
 }  // namespace rig_calibrator

@@ -188,5 +188,26 @@ TEST(PoseTrajectory, RejectsBadInputWithAMessage) {
   EXPECT_NE(error.find("pose 1"), std::string::npos) << error;
 }
 
+// Knots cut at gaps above max_gap_s; a lone knot between gaps makes no
+// piece; the pieces span their knots.
+TEST(PoseTrajectory, PiecewiseCutsAtGapsAndDropsLoneKnots) {
+  const std::vector<double> times = {0.0, 0.2, 0.4, 2.0, 4.0, 4.2, 4.4, 4.6};
+  std::vector<Rigid3d> poses;
+  for (const double t : times) {
+    poses.emplace_back(Eigen::Quaterniond(Eigen::AngleAxisd(
+                           0.3 * t, Eigen::Vector3d::UnitZ())),
+                       Eigen::Vector3d(t, 0, 0));
+  }
+  const std::vector<PoseTrajectory> pieces =
+      PiecewisePoseTrajectories(times, poses, 0.5);
+  ASSERT_EQ(pieces.size(), 2u);
+  EXPECT_EQ(pieces[0].StartTime(), 0.0);
+  EXPECT_EQ(pieces[0].EndTime(), 0.4);
+  EXPECT_EQ(pieces[1].StartTime(), 4.0);
+  EXPECT_EQ(pieces[1].EndTime(), 4.6);
+  EXPECT_EQ(PiecewisePoseTrajectories(times, poses, 10.0).size(), 1u);
+  EXPECT_TRUE(PiecewisePoseTrajectories({1.0}, {poses[0]}, 1.0).empty());
+}
+
 }  // namespace pose_interpolation_test
 }  // namespace rig_calibrator
