@@ -21,6 +21,9 @@
 #   TIME_MODEL_PRESETS        presets (default: ring5 fisheye_helmet5
 #                             car_surround4)
 #   FRAMESET_RATE_HZ          frameset rate (default 5)
+#   IMAGE_HEIGHT              every camera scaled to this many rows (default
+#                             0: the presets' 480-600; 1080: the rows of a
+#                             1080p rolling shutter, the issue's case)
 set -euo pipefail
 
 log_tag=benchmark_time_model
@@ -32,6 +35,7 @@ results="$1"
 framesets="${2:-100}"
 rate_hz="${FRAMESET_RATE_HZ:-5}"
 unit_s="$(/usr/bin/python3 -c "print(1 / $rate_hz)")"
+image_height="${IMAGE_HEIGHT:-0}"
 read -r -a presets <<<"${TIME_MODEL_PRESETS:-ring5 fisheye_helmet5 car_surround4}"
 [[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create $results"
@@ -52,7 +56,7 @@ for preset in "${presets[@]}"; do
     # shellcheck disable=SC2086
     "$rig_calibrator_lab" synthetic --output_path "$dir/data" --preset "$preset" \
       --num_framesets "$framesets" --frameset_rate_hz "$rate_hz" --speed_m_s 1.5 \
-      --max_turn_rate_deg_s 60 ${case_options[$case_name]} \
+      --max_turn_rate_deg_s 60 --image_height "$image_height" ${case_options[$case_name]} \
       >"$dir/synthetic.log" || die "generating $dir failed; see $dir/synthetic.log"
     # A calibration that reports an error still writes its outputs; the
     # table says so.

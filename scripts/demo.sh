@@ -21,12 +21,15 @@
 #                    unsynchronized rolling-shutter cameras (GoPro-like):
 #                    framesets at 5 Hz, capture-time offsets drawn in
 #                    +-50 ms, line delays in 20-30 us per row, the rig at
-#                    1.5 m/s turning at up to 60 deg/s; the images are named
-#                    by their capture times and grouped into framesets by
+#                    1.5 m/s turning at up to 60 deg/s on one continuous
+#                    trajectory; the images are named by their capture times
+#                    and grouped into framesets by
 #                    --RigCalibrator.timestamp_tolerance
-#   DEMO_SCENE       room (default), courtyard, street
+#   DEMO_SCENE       room (default; courtyard for gopro_helmet5, whose walk
+#                    at 1.5 m/s is too fast for the room), courtyard, street
 #   DEMO_SEED        0 (default)
-#   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 20)
+#   DEMO_MAP_IMAGES  map images (default 60); DEMO_FRAMESETS (default 20;
+#                    40 for gopro_helmet5: 8 s of its walk)
 #   DEMO_CAMERA_MODEL  --RigCalibrator.camera_model: auto (default, the
 #                    command's default), "true" (the rendered rig's true
 #                    models), or any value the option takes
@@ -43,10 +46,14 @@ log_tag=demo
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 out="${1:-$repo/demo_output/rendered}"
 preset="${DEMO_PRESET:-ring5}"
-scene="${DEMO_SCENE:-room}"
+default_scene=room
+[[ "$preset" != gopro_helmet5 ]] || default_scene=courtyard
+scene="${DEMO_SCENE:-$default_scene}"
 seed="${DEMO_SEED:-0}"
 num_map_images="${DEMO_MAP_IMAGES:-60}"
-num_framesets="${DEMO_FRAMESETS:-20}"
+default_framesets=20
+[[ "$preset" != gopro_helmet5 ]] || default_framesets=40
+num_framesets="${DEMO_FRAMESETS:-$default_framesets}"
 camera_model="${DEMO_CAMERA_MODEL:-auto}"
 read -r -a calibration_options <<< "${DEMO_CALIBRATION_OPTIONS:-}"
 # A folder this demo wrote before (it holds the marker file) is replaced; any

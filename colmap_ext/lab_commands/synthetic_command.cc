@@ -65,6 +65,9 @@ int RunSynthetic(int argc, char** argv) {
             "map units per metre (1000: a map in millimetres)");
   AddOption(&description, "ring_num_cameras", &options.ring_num_cameras,
             "ring5 only: that many cameras on the ring (0: 5)");
+  AddOption(&description, "image_height", &options.image_height,
+            "every camera's image scaled to this many rows, intrinsics with "
+            "it (0: the preset's sizes; 1080 for a 1080p rolling shutter)");
   AddOption(&description, "num_map_images", &options.num_map_images,
             "map images: > 0 writes the map as a COLMAP model (sparse/, "
             "with the map images' observations) and the correspondences "

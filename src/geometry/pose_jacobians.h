@@ -1,6 +1,7 @@
 // Derivatives of a point moved by a pose block [qw, qx, qy, qz, tx, ty, tz]
 // (PoseParams, rigid3d.h), p' = R(q) p + t, shared by the bundle
-// adjustments' costs (rig_reprojection_cost.h, radial_rig_cost_function.h).
+// adjustments' costs (rig_reprojection_cost.h, timed_rig_reprojection_cost.h,
+// radial_rig_cost_function.h).
 #pragma once
 
 #include <ceres/manifold.h>
@@ -48,6 +49,28 @@ Eigen::Matrix<double, kRows, 3> RotationTangentJacobian(
                 .transpose();
   }
   return jacobian;
+}
+
+// The Jacobian of a residual r over a pose block, [dr/d(rotation), dr/dt],
+// given dr/d(R p + t) = `d_point` (rows x 3), the pose's rotation, the point
+// p it moves and its rotated part R p: ambient over (q, t), rows x 7, or
+// (kTangent) over RigPoseManifold's (d, t), rows x 6; row-major into
+// `jacobian`.
+template <bool kTangent, int kRows>
+void WritePoseJacobian(const Eigen::Matrix<double, kRows, 3>& d_point,
+                       const Eigen::Quaterniond& rotation,
+                       const Eigen::Vector3d& unrotated,
+                       const Eigen::Vector3d& rotated, double* jacobian) {
+  if constexpr (kTangent) {
+    Eigen::Map<Eigen::Matrix<double, kRows, 6, Eigen::RowMajor>> out(jacobian);
+    out.template leftCols<3>() = RotationTangentJacobian<kRows>(d_point, rotated);
+    out.template rightCols<3>() = d_point;
+  } else {
+    Eigen::Map<Eigen::Matrix<double, kRows, 7, Eigen::RowMajor>> out(jacobian);
+    out.template leftCols<4>() =
+        d_point * RotatedPointQuaternionJacobian(rotation, unrotated);
+    out.template rightCols<3>() = d_point;
+  }
 }
 
 }  // namespace rig_calibrator

@@ -88,18 +88,8 @@ bool RadialRigCostFunction::EvaluateImpl(double const* const* parameters,
   }
   if (jacobians[1] != nullptr) {
     const Eigen::Matrix<double, 2, 3> d_rig = d_cam * cam_rotation;
-    if constexpr (kTangent) {
-      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
-          jacobians[1]);
-      jacobian.leftCols<3>() = RotationTangentJacobian<2>(d_rig, rig_rotated);
-      jacobian.rightCols<3>() = d_rig;
-    } else {
-      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> jacobian(
-          jacobians[1]);
-      jacobian.leftCols<4>() =
-          d_rig * RotatedPointQuaternionJacobian(rig_quaternion, point3D_);
-      jacobian.rightCols<3>() = d_rig;
-    }
+    WritePoseJacobian<kTangent, 2>(d_rig, rig_quaternion, point3D_,
+                                   rig_rotated, jacobians[1]);
   }
   if (jacobians[2] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 2, Eigen::RowMajor>> jacobian(

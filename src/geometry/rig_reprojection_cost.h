@@ -81,27 +81,6 @@ class RigReprojectionCost final : public TangentJacobianCost {
   }
 
  private:
-  // The pose Jacobian [dr/d(rotation), dr/dt] for the point's rotated part
-  // `rotated` = R p of that pose and dr/d(R p + t) = d_pixel: ambient over
-  // (q, t) or, kTangent, over RigPoseManifold's (d, t).
-  template <bool kTangent>
-  static void WritePoseJacobian(const Eigen::Matrix<double, 2, 3>& d_pixel,
-                                const Eigen::Quaterniond& rotation,
-                                const Eigen::Vector3d& unrotated,
-                                const Eigen::Vector3d& rotated,
-                                double* jacobian) {
-    if constexpr (kTangent) {
-      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> out(jacobian);
-      out.template leftCols<3>() = RotationTangentJacobian<2>(d_pixel, rotated);
-      out.template rightCols<3>() = d_pixel;
-    } else {
-      Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> out(jacobian);
-      out.template leftCols<4>() =
-          d_pixel * RotatedPointQuaternionJacobian(rotation, unrotated);
-      out.template rightCols<3>() = d_pixel;
-    }
-  }
-
   template <bool kTangent>
   bool EvaluateImpl(double const* const* parameters, double* residuals,
                     double** jacobians) const {
@@ -148,14 +127,14 @@ class RigReprojectionCost final : public TangentJacobianCost {
     d_pixel_d_cam.col(2) =
         -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
     if (jacobians[1] != nullptr) {
-      WritePoseJacobian<kTangent>(d_pixel_d_cam, cam_rotation, point_in_rig,
-                                  cam_rotated, jacobians[1]);
+      WritePoseJacobian<kTangent, 2>(d_pixel_d_cam, cam_rotation,
+                                     point_in_rig, cam_rotated, jacobians[1]);
     }
     const Eigen::Matrix<double, 2, 3> d_pixel_d_rig =
         d_pixel_d_cam * cam_rotation_matrix;
     if (jacobians[0] != nullptr) {
-      WritePoseJacobian<kTangent>(d_pixel_d_rig, rig_rotation, point3D,
-                                  rig_rotated, jacobians[0]);
+      WritePoseJacobian<kTangent, 2>(d_pixel_d_rig, rig_rotation, point3D,
+                                     rig_rotated, jacobians[0]);
     }
     if (variable_point_ && jacobians[3] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(

@@ -1,78 +1,147 @@
 #include "src/geometry/timed_rig_reprojection_cost.h"
 
-#include <ceres/autodiff_cost_function.h>
 #include <colmap/base/camera_models.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+#include "src/geometry/camera_model_jacobians.h"
+#include "src/geometry/pose_interpolation.h"
+#include "src/geometry/pose_jacobians.h"
 
 namespace rig_calibrator {
 namespace {
 
-// r = pi_theta(P Exp(-u(tau)) (Q X - p(tau))) - x (see the header).
-template <typename CameraModel, typename T>
-bool TimedResidual(const T* rig_from_world, const T* cam_from_rig,
-                   const T* params, const T& time_offset, const T& line_delay,
-                   const FramesetMotion& motion, const T* point,
-                   const Eigen::Vector2d& observed, T* residuals) {
-  const T tau = CaptureTimeOfRow(time_offset, line_delay, observed.y());
-  T point_in_rig[3];
-  WorldToRigAtOffset(rig_from_world, point, motion, tau, point_in_rig);
-  T point_in_cam[3];
-  ceres::QuaternionRotatePoint(cam_from_rig, point_in_rig, point_in_cam);
-  for (int k = 0; k < 3; ++k) point_in_cam[k] += cam_from_rig[4 + k];
-  if (!(point_in_cam[2] > 0.0)) return false;
-  CameraModel::WorldToImage(params, point_in_cam[0] / point_in_cam[2],
-                            point_in_cam[1] / point_in_cam[2], &residuals[0],
-                            &residuals[1]);
-  residuals[0] -= observed.x();
-  residuals[1] -= observed.y();
-  return true;
-}
-
-// The point fixed at construction.
+// r = pi_theta(P Exp(-u(tau)) (Q X - p(tau))) - x with the Jacobians of the
+// header.
 template <typename CameraModel>
-struct TimedCostFixedPoint {
-  template <typename T>
-  bool operator()(const T* rig_from_world, const T* cam_from_rig,
-                  const T* params, const T* time_offset, const T* line_delay,
-                  T* residuals) const {
-    const T point[3] = {T(point3D.x()), T(point3D.y()), T(point3D.z())};
-    return TimedResidual<CameraModel>(rig_from_world, cam_from_rig, params,
-                                      time_offset[0], line_delay[0], *motion,
-                                      point, observed, residuals);
+class TimedRigReprojectionCost final : public TangentJacobianCost {
+ public:
+  static constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
+
+  TimedRigReprojectionCost(const Eigen::Vector2d& observed,
+                           const Eigen::Vector3d* point3D,
+                           const FramesetMotion* motion)
+      : observed_(observed),
+        fixed_point3D_(point3D != nullptr ? *point3D : Eigen::Vector3d::Zero()),
+        variable_point_(point3D == nullptr),
+        motion_(motion) {
+    set_num_residuals(2);
+    *mutable_parameter_block_sizes() =
+        variable_point_ ? std::vector<int32_t>{7, 7, kNumParams, 1, 1, 3}
+                        : std::vector<int32_t>{7, 7, kNumParams, 1, 1};
   }
-  Eigen::Vector2d observed;
-  Eigen::Vector3d point3D;
-  const FramesetMotion* motion;
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return EvaluateImpl</*kTangent=*/false>(parameters, residuals, jacobians);
+  }
+  int TangentSize(int parameter_block) const override {
+    return parameter_block < 2 ? 6 : 0;
+  }
+  bool EvaluateTangent(double const* const* parameters, double* residuals,
+                       double** jacobians) const override {
+    return EvaluateImpl</*kTangent=*/true>(parameters, residuals, jacobians);
+  }
+
+ private:
+  template <bool kTangent>
+  bool EvaluateImpl(double const* const* parameters, double* residuals,
+                    double** jacobians) const {
+    const double* rig_from_world = parameters[0];
+    const double* cam_from_rig = parameters[1];
+    const double* camera_params = parameters[2];
+    const FramesetMotion& motion = *motion_;
+    const Eigen::Quaterniond rig_rotation(rig_from_world[0], rig_from_world[1],
+                                          rig_from_world[2], rig_from_world[3]);
+    const Eigen::Quaterniond cam_rotation(cam_from_rig[0], cam_from_rig[1],
+                                          cam_from_rig[2], cam_from_rig[3]);
+    const Eigen::Matrix3d rig_rotation_matrix = rig_rotation.toRotationMatrix();
+    const Eigen::Matrix3d cam_rotation_matrix = cam_rotation.toRotationMatrix();
+    const Eigen::Vector3d point3D =
+        variable_point_ ? Eigen::Vector3d(parameters[5]) : fixed_point3D_;
+
+    // u(tau), p(tau) and their derivatives in tau (frameset_motion.h).
+    const double tau =
+        CaptureTimeOfRow(parameters[3][0], parameters[4][0], observed_.y());
+    const double a1 = tau, a2 = tau * tau / 2, a3 = tau * tau * tau / 6;
+    const Eigen::Map<const Eigen::Vector3d> u1(&motion[0]), u2(&motion[3]),
+        u3(&motion[6]), p1(&motion[9]), p2(&motion[12]), p3(&motion[15]);
+    const Eigen::Vector3d phi = -(a1 * u1 + a2 * u2 + a3 * u3);
+    const Eigen::Vector3d p = a1 * p1 + a2 * p2 + a3 * p3;
+
+    const Eigen::Vector3d rig_rotated = rig_rotation_matrix * point3D;
+    const Eigen::Vector3d w =
+        rig_rotated + Eigen::Vector3d(rig_from_world + 4) - p;
+    const Eigen::Matrix3d motion_rotation = ExpSO3(phi);
+    const Eigen::Vector3d point_in_rig = motion_rotation * w;
+    const Eigen::Vector3d cam_rotated = cam_rotation_matrix * point_in_rig;
+    const Eigen::Vector3d point_in_cam =
+        cam_rotated + Eigen::Vector3d(cam_from_rig + 4);
+    const double z = point_in_cam.z();
+    if (!(z > 0)) return false;
+    const double u = point_in_cam.x() / z;
+    const double v = point_in_cam.y() / z;
+    if (jacobians == nullptr) {
+      CameraModel::WorldToImage(camera_params, u, v, &residuals[0],
+                                &residuals[1]);
+      residuals[0] -= observed_.x();
+      residuals[1] -= observed_.y();
+      return true;
+    }
+
+    Eigen::Matrix2d d_pixel_d_uv;
+    ProjectWithJacobians<CameraModel>(camera_params, u, v, residuals,
+                                      &d_pixel_d_uv, jacobians[2]);
+    residuals[0] -= observed_.x();
+    residuals[1] -= observed_.y();
+    Eigen::Matrix<double, 2, 3> d_pixel_d_cam;
+    d_pixel_d_cam.col(0) = d_pixel_d_uv.col(0) / z;
+    d_pixel_d_cam.col(1) = d_pixel_d_uv.col(1) / z;
+    d_pixel_d_cam.col(2) =
+        -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
+    if (jacobians[1] != nullptr) {
+      WritePoseJacobian<kTangent, 2>(d_pixel_d_cam, cam_rotation, point_in_rig,
+                                     cam_rotated, jacobians[1]);
+    }
+    const Eigen::Matrix<double, 2, 3> d_pixel_d_rig =
+        d_pixel_d_cam * cam_rotation_matrix;
+    const Eigen::Matrix<double, 2, 3> d_pixel_d_frameset =
+        d_pixel_d_rig * motion_rotation;
+    if (jacobians[0] != nullptr) {
+      WritePoseJacobian<kTangent, 2>(d_pixel_d_frameset, rig_rotation, point3D,
+                                     rig_rotated, jacobians[0]);
+    }
+    if (jacobians[3] != nullptr || jacobians[4] != nullptr) {
+      const Eigen::Vector3d du = u1 + tau * u2 + a2 * u3;
+      const Eigen::Vector3d dp = p1 + tau * p2 + a2 * p3;
+      const Eigen::Vector3d d_point_d_tau =
+          motion_rotation * (w.cross(RightJacobianSO3(phi) * du) - dp);
+      const Eigen::Vector2d d_pixel_d_tau = d_pixel_d_rig * d_point_d_tau;
+      if (jacobians[3] != nullptr) {
+        jacobians[3][0] = d_pixel_d_tau.x();
+        jacobians[3][1] = d_pixel_d_tau.y();
+      }
+      if (jacobians[4] != nullptr) {
+        const double row = observed_.y() - 0.5;
+        jacobians[4][0] = d_pixel_d_tau.x() * row;
+        jacobians[4][1] = d_pixel_d_tau.y() * row;
+      }
+    }
+    if (variable_point_ && jacobians[5] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(
+          jacobians[5]);
+      jacobian = d_pixel_d_frameset * rig_rotation_matrix;
+    }
+    return true;
+  }
+
+  const Eigen::Vector2d observed_;
+  const Eigen::Vector3d fixed_point3D_;
+  const bool variable_point_;
+  const FramesetMotion* motion_;
 };
-
-// The point the sixth block.
-template <typename CameraModel>
-struct TimedCostRefinedPoint {
-  template <typename T>
-  bool operator()(const T* rig_from_world, const T* cam_from_rig,
-                  const T* params, const T* time_offset, const T* line_delay,
-                  const T* point, T* residuals) const {
-    return TimedResidual<CameraModel>(rig_from_world, cam_from_rig, params,
-                                      time_offset[0], line_delay[0], *motion,
-                                      point, observed, residuals);
-  }
-  Eigen::Vector2d observed;
-  const FramesetMotion* motion;
-};
-
-template <typename CameraModel>
-ceres::CostFunction* CreateTimedCost(const Eigen::Vector2d& observed,
-                                     const Eigen::Vector3d* point3D,
-                                     const FramesetMotion* motion) {
-  constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
-  if (point3D != nullptr) {
-    return new ceres::AutoDiffCostFunction<TimedCostFixedPoint<CameraModel>,
-                                           2, 7, 7, kNumParams, 1, 1>(
-        new TimedCostFixedPoint<CameraModel>{observed, *point3D, motion});
-  }
-  return new ceres::AutoDiffCostFunction<TimedCostRefinedPoint<CameraModel>,
-                                         2, 7, 7, kNumParams, 1, 1, 3>(
-      new TimedCostRefinedPoint<CameraModel>{observed, motion});
-}
 
 }  // namespace
 
@@ -80,9 +149,10 @@ ceres::CostFunction* CreateTimedRigReprojectionCost(
     int model_id, const Eigen::Vector2d& observed,
     const Eigen::Vector3d* point3D, const FramesetMotion* motion) {
   switch (model_id) {
-#define CAMERA_MODEL_CASE(CameraModel) \
-  case colmap::CameraModel::kModelId:  \
-    return CreateTimedCost<colmap::CameraModel>(observed, point3D, motion);
+#define CAMERA_MODEL_CASE(CameraModel)                                  \
+  case colmap::CameraModel::kModelId:                                   \
+    return new TimedRigReprojectionCost<colmap::CameraModel>(observed, \
+                                                             point3D, motion);
     CAMERA_MODEL_CASES
 #undef CAMERA_MODEL_CASE
     default:

@@ -24,8 +24,21 @@
 // theta (the model's kNumParams), delta_c (1), rho_c (1) and, when the point
 // is refined, X (3). A block the adjustment does not add (the reference
 // camera's delta, which is 0; rho when rolling shutter is off) is a
-// constant of the solver. Jacobians by automatic differentiation (both
-// bundle solvers take them: bundle_solver.h).
+// constant of the solver.
+//
+// Jacobians, analytic as in rig_reprojection_cost.h (whose d_pixel/d_cam,
+// pose and intrinsics parts they share), with
+//   y = R_Q X + t_Q,  w = y - p(tau),  phi = -u(tau),  z = Exp(phi) w,
+//   p_cam = R_P z + t_P:
+//   dr/d(P)  as there, for the point z,
+//   dr/dy    = dr/dz Exp(phi),  dr/dz = dr/dp_cam R_P, and Q and X from dr/dy
+//              as there,
+//   dr/dtau  = dr/dz Exp(phi) ([w]x Jr(phi) u'(tau) - p'(tau)),
+//   dr/ddelta = dr/dtau,  dr/drho = dr/dtau (y_obs - 0.5),
+// from d/dtau Exp(phi) = Exp(phi) [Jr(phi) phi']x (Jr the right Jacobian,
+// pose_interpolation.h), phi' = -u'(tau), u'(tau) = u1 + tau u2 +
+// tau^2/2 u3 and p'(tau) likewise. Why analytic: automatic Jacobians made a
+// timed iteration 4 times a synchronized one (docs/benchmarks.md).
 // A point that is not in front of the camera is an invalid evaluation.
 #pragma once
 
@@ -34,13 +47,15 @@
 #include <Eigen/Core>
 
 #include "src/geometry/frameset_motion.h"
+#include "src/geometry/tangent_jacobian_cost.h"
 
 namespace rig_calibrator {
 
 // r above for the COLMAP model `model_id`, observing `observed`; `point3D`
 // fixed, or null for a refined point (the sixth block); `motion` the
-// frameset's, read at every evaluation (it must outlive the cost). Null for
-// an unknown model id. The caller owns the result.
+// frameset's, read at every evaluation (it must outlive the cost). A
+// TangentJacobianCost (the poses in RigPoseManifold's tangent space). Null
+// for an unknown model id. The caller owns the result.
 ceres::CostFunction* CreateTimedRigReprojectionCost(
     int model_id, const Eigen::Vector2d& observed,
     const Eigen::Vector3d* point3D, const FramesetMotion* motion);

@@ -43,11 +43,10 @@ namespace rig_calibrator {
 struct ImageCapture {
   const RigTrajectory* trajectory = nullptr;
   // Where the trajectory lies in the world: world_from_body(t) =
-  // world_from_trajectory * trajectory->WorldFromBody(t). Unset for the
-  // synthetic generator, whose trajectory is in the world frame (the
-  // identity; not composed, so its data stay bit for bit); a rendered
-  // dataset moves the trajectory onto each frameset's planned pose
-  // (rendered_dataset.h).
+  // world_from_trajectory * trajectory->WorldFromBody(t). Unset (the
+  // identity, not composed) for the synthetic generator's and the rendered
+  // datasets' trajectories, which are in the world frame; set where a
+  // trajectory's piece must stand at a given place (a renderer's test).
   std::optional<Rigid3d> world_from_trajectory;
   Rigid3d body_from_rig;  // RigGroundTruth::body_from_rig
   Rigid3d cam_from_rig;

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <random>
 
+#include "src/synthetic/ground_loop.h"
 #include "src/synthetic/rig_presets.h"
+#include "src/synthetic/rig_trajectory.h"
 
 namespace rig_calibrator {
 namespace {
@@ -155,9 +157,10 @@ bool PlanMapSequence(const RenderedDatasetOptions& options,
   return true;
 }
 
-// The rig: the same loop as the map camera's, smaller, half a step out of
-// phase, with random heading swings up to 45 degrees and tilts up to 8
-// degrees; 4 draws per frameset.
+// Without a time model, the rig: the same loop as the map camera's, smaller,
+// half a step out of phase, with random heading swings up to 45 degrees and
+// tilts up to 8 degrees; 4 draws per frameset. Each frameset at one instant,
+// its poses seconds apart.
 bool PlanRigSequence(const RenderedDatasetOptions& options,
                      std::mt19937* random, RenderedDatasetPlan* plan,
                      std::string* error) {
@@ -196,38 +199,52 @@ bool PlanRigSequence(const RenderedDatasetOptions& options,
   return true;
 }
 
-// The time model (options.time_model.frameset_rate_hz > 0; see the
-// header): the trajectory (its 4 phases drawn from *random after the rig
-// sequence's draws), the frameset times and names, the anchors W_f * B(t_f)^-1
-// and the offsets and line delays (DrawCaptureTimes with the dataset's seed).
-// Fails when a rig camera would stand in a wall when its top or bottom row
-// is taken.
-bool PlanTimeModel(const RenderedDatasetOptions& options,
-                   std::mt19937* random, RenderedDatasetPlan* plan,
-                   std::string* error) {
+// With a time model (options.time_model.frameset_rate_hz > 0; see the
+// header): the rig walks the scene's walk loop, kRigWalkScale as large, on
+// one continuous trajectory from a random point of it (1 draw, then the
+// trajectory's 4 phases), with the offsets and line delays of
+// DrawCaptureTimes (the dataset's seed). Fails when the loop alone turns
+// faster than three quarters of the turn rate (the rest is the rig's
+// look-around swing), or when a rig camera would stand in a wall when its
+// top or bottom row is taken.
+bool PlanRigWalk(const RenderedDatasetOptions& options, std::mt19937* random,
+                 RenderedDatasetPlan* plan, std::string* error) {
   const SyntheticRigOptions& time_model = options.time_model;
+  const SceneWalk& walk = plan->scene.walk();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const GroundLoop loop(walk.center, kRigWalkScale * walk.radii,
+                        2 * M_PI * unit(*random));
+  const double loop_turn_rate_deg_s =
+      RigTrajectory::LoopTurnRateDegS(loop, time_model.speed_m_s);
+  if (loop_turn_rate_deg_s > 0.75 * time_model.max_turn_rate_deg_s) {
+    *error = "walking the " + SceneTypeName(options.scene) +
+             " scene's loop at " + std::to_string(time_model.speed_m_s) +
+             " m/s turns at up to " + std::to_string(loop_turn_rate_deg_s) +
+             " deg/s, more than three quarters of max_turn_rate_deg_s: use a "
+             "larger scene (courtyard), a lower speed_m_s or a higher "
+             "max_turn_rate_deg_s";
+    return false;
+  }
   RigGroundTruth& rig = plan->rig;
-  rig.trajectory.emplace(MakePresetDefinition(options.preset, 0).motion,
-                         time_model.speed_m_s, time_model.max_turn_rate_deg_s,
-                         /*rotation_only=*/false, random);
+  rig = MakeRigPreset(options.preset);
   rig.body_from_rig = BodyFromRig(rig.cam_from_rig);
+  MotionProfile motion = MakePresetDefinition(options.preset, 0).motion;
+  motion.height_m =
+      options.rig_height > 0 ? options.rig_height : walk.eye_height;
+  rig.trajectory.emplace(motion, time_model.speed_m_s,
+                         time_model.max_turn_rate_deg_s, loop, random);
   SyntheticRigOptions draws = time_model;
   draws.seed = options.seed;
   DrawCaptureTimes(draws, &rig);
-  const Rigid3d rig_from_body = rig.body_from_rig.Inverse();
   for (int f = 0; f < options.num_framesets; ++f) {
     const double time_s = (f + 1) / time_model.frameset_rate_hz;
     rig.frameset_times_s.push_back(time_s);
-    plan->frameset_names[f] = Timestamp(time_s);
-    const Rigid3d world_from_body =
-        rig.rig_from_world[f].Inverse() * rig_from_body;
-    plan->world_from_trajectory.push_back(
-        world_from_body * rig.trajectory->WorldFromBody(time_s).Inverse());
+    rig.rig_from_world.push_back(RigFromWorldAtTime(rig, time_s));
+    plan->frameset_names.push_back(Timestamp(time_s));
   }
   for (int f = 0; f < options.num_framesets; ++f) {
     for (size_t c = 0; c < rig.cameras.size(); ++c) {
-      const ImageCapture capture =
-          plan->RigImageCapture(static_cast<int>(c), f);
+      const ImageCapture capture = CaptureOfImage(rig, static_cast<int>(c), f);
       const double bottom_row_y = rig.cameras[c].Height() - 0.5;
       for (const double y : {0.5, bottom_row_y}) {
         const Eigen::Vector3d center =
@@ -235,8 +252,9 @@ bool PlanTimeModel(const RenderedDatasetOptions& options,
         if (!plan->scene.IsFree(center, kMinClearance)) {
           *error = "rig camera " + rig.camera_names[c] + " of frameset " +
                    std::to_string(f) +
-                   " would stand in a wall during its capture: the rig "
-                   "moves too far (speed_m_s, time offsets)";
+                   " would stand in a wall during its capture: the " +
+                   RigPresetName(options.preset) + " rig does not fit the " +
+                   SceneTypeName(options.scene) + " scene's loop";
           return false;
         }
       }
@@ -307,9 +325,7 @@ std::string RenderedDatasetPlan::RigImageName(int camera_index,
 
 ImageCapture RenderedDatasetPlan::RigImageCapture(int camera_index,
                                                   int frameset_index) const {
-  ImageCapture capture = CaptureOfImage(rig, camera_index, frameset_index);
-  capture.world_from_trajectory = world_from_trajectory[frameset_index];
-  return capture;
+  return CaptureOfImage(rig, camera_index, frameset_index);
 }
 
 double RenderedDatasetPlan::TimestampTolerance() const {
@@ -322,13 +338,12 @@ bool PlanRenderedDataset(const RenderedDatasetOptions& options,
   if (!options.Check(error)) return false;
   *plan = RenderedDatasetPlan();
   plan->scene = TexturedScene::Make(options.scene, options.seed);
-  // One random stream: the map sequence's draws, then the rig's, then the
-  // trajectory's phases.
+  // One random stream: the map sequence's draws, then the rig's.
   std::mt19937 random(options.seed);
-  return PlanMapSequence(options, &random, plan, error) &&
-         PlanRigSequence(options, &random, plan, error) &&
-         (options.time_model.frameset_rate_hz == 0 ||
-          PlanTimeModel(options, &random, plan, error));
+  if (!PlanMapSequence(options, &random, plan, error)) return false;
+  return options.time_model.frameset_rate_hz > 0
+             ? PlanRigWalk(options, &random, plan, error)
+             : PlanRigSequence(options, &random, plan, error);
 }
 
 }  // namespace rig_calibrator

@@ -13,17 +13,16 @@
 //
 // With a time model (time_model.frameset_rate_hz > 0) every rig image is
 // taken at its own time and each row of a rolling shutter at its own
-// (capture_model.h), with the synthetic generator's continuous trajectory
-// (rig_trajectory.h) and capture-time offsets and line delays
-// (DrawCaptureTimes). The planned rig poses are seconds apart and need not
-// follow one trajectory, so around frameset f the trajectory is moved
-// rigidly onto the planned pose:
-//   world_from_body(t) = W_f * B(t_f)^-1 * B(t),
-// W_f the planned world_from_body, B the trajectory's; the rig passes
-// through its planned pose at t_f with the trajectory's velocities (body
-// frame), and an image needs the motion only within its offset and readout
-// (tens of milliseconds) of t_f. Frameset f's time is t_f = (f + 1) /
-// frameset_rate_hz, so that every capture time is positive.
+// (capture_model.h), with capture-time offsets and line delays
+// (DrawCaptureTimes), and the rig moves on one continuous trajectory
+// (rig_trajectory.h) through all framesets: it walks the scene's walk loop,
+// 0.65 times as large, at speed_m_s, looking outward with the preset's
+// swings of heading, pitch and roll and its bob, its heading turning at up
+// to max_turn_rate_deg_s (the loop's own turn must stay below three
+// quarters of it: at 1.5 m/s and 60 deg/s the courtyard, not the room or
+// the street). Frameset f's time is t_f = (f + 1) / frameset_rate_hz, so
+// that every capture time is positive, and rig_from_world[f] is the rig
+// pose at t_f.
 #pragma once
 
 #include <colmap/base/camera.h>
@@ -75,9 +74,6 @@ struct RenderedDatasetPlan {
   RigGroundTruth rig;
   // "000012"; with a time model the time stamp of t_f (Timestamp).
   std::vector<std::string> frameset_names;
-  // With a time model, per frameset: W_f * B(t_f)^-1 (above), where the
-  // trajectory lies in the world around frameset f.
-  std::vector<Rigid3d> world_from_trajectory;
 
   bool HasTimeModel() const { return rig.trajectory.has_value(); }
   // "cam3/000012.png": the image of a rig camera in a frameset, relative to
@@ -101,7 +97,8 @@ std::string Timestamp(double time_s);
 
 // Fails (with a message) for invalid options, or when a camera would stand
 // inside or within 0.25 m of a surface (with a time model: when its top or
-// bottom row is taken).
+// bottom row is taken), or when the scene's loop turns too fast for the
+// time model's speed and turn rate.
 bool PlanRenderedDataset(const RenderedDatasetOptions& options,
                          RenderedDatasetPlan* plan, std::string* error);
 

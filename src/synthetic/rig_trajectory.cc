@@ -3,6 +3,7 @@
 #include <colmap/util/math.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace rig_calibrator {
@@ -33,6 +34,31 @@ RigTrajectory::RigTrajectory(const MotionProfile& motion, double speed_m_s,
                           : motion.step_m / speed_m_s;
 }
 
+RigTrajectory::RigTrajectory(const MotionProfile& motion, double speed_m_s,
+                             double max_turn_rate_deg_s, const GroundLoop& loop,
+                             std::mt19937* rng)
+    : RigTrajectory(motion, speed_m_s, max_turn_rate_deg_s,
+                    /*rotation_only=*/false, rng) {
+  loop_.emplace(loop);
+  motion_.yaw_rate_deg = 0;
+  // The swing's peak rate A_yaw 2 pi / P_yaw per step gets what the loop
+  // leaves of the turn rate (a tenth of it at least, when the caller broke
+  // the precondition).
+  const double swing_budget_deg_s =
+      std::max(max_turn_rate_deg_s - LoopTurnRateDegS(loop, speed_m_s),
+               0.1 * max_turn_rate_deg_s);
+  const double swing_deg_per_step =
+      motion.yaw_amplitude_deg * 2 * M_PI / motion.yaw_period;
+  seconds_per_step_ = swing_deg_per_step > 0
+                          ? swing_deg_per_step / swing_budget_deg_s
+                          : motion.step_m / speed_m_s;
+}
+
+double RigTrajectory::LoopTurnRateDegS(const GroundLoop& loop,
+                                       double speed_m_s) {
+  return colmap::RadToDeg(speed_m_s * loop.MaxAngleRatePerMeter());
+}
+
 void RigTrajectory::AnglesAt(double t, Angles* angles, Angles* rates) const {
   const double s = t / seconds_per_step_;
   const double ds_dt = 1 / seconds_per_step_;
@@ -59,10 +85,25 @@ void RigTrajectory::AnglesAt(double t, Angles* angles, Angles* rates) const {
   rates->roll = colmap::DegToRad(motion_.roll_amplitude_deg * roll_frequency *
                                  std::cos(roll_argument)) *
                 ds_dt;
+  if (loop_) {
+    double angle_rate_per_m = 0;
+    angles->yaw += loop_->AngleAt(speed_m_s_ * t, &angle_rate_per_m);
+    rates->yaw += speed_m_s_ * angle_rate_per_m;
+  }
 }
 
 Eigen::Vector3d RigTrajectory::PositionAt(double t) const {
   const double time = rotation_only_ ? 0.0 : t;
+  if (loop_) {
+    double angle_rate_per_m = 0;
+    const Eigen::Vector2d ground =
+        loop_->PointAt(loop_->AngleAt(speed_m_s_ * time, &angle_rate_per_m));
+    return Eigen::Vector3d(
+        ground.x(), ground.y(),
+        motion_.height_m +
+            motion_.bob_m *
+                std::sin(M_PI * time / seconds_per_step_ + bob_phase_));
+  }
   // The track heading psi = kappa t (kappa = r_yaw / tau, rad/s); the
   // position is the integral of v (cos psi, sin psi):
   //   x = v sin(kappa t) / kappa = v t sinc(kappa t),
@@ -92,14 +133,21 @@ Rigid3d RigTrajectory::WorldFromBody(double t) const {
 
 Eigen::Vector3d RigTrajectory::LinearVelocity(double t) const {
   if (rotation_only_) return Eigen::Vector3d::Zero();
+  const double s = t / seconds_per_step_;
+  const double bob_rate = motion_.bob_m * M_PI / seconds_per_step_ *
+                          std::cos(M_PI * s + bob_phase_);
+  if (loop_) {
+    double angle_rate_per_m = 0;
+    const double angle = loop_->AngleAt(speed_m_s_ * t, &angle_rate_per_m);
+    const Eigen::Vector2d ground =
+        loop_->TangentAt(angle) * speed_m_s_ * angle_rate_per_m;
+    return position_scale_ * Eigen::Vector3d(ground.x(), ground.y(), bob_rate);
+  }
   const double kappa =
       colmap::DegToRad(motion_.yaw_rate_deg) / seconds_per_step_;
-  const double s = t / seconds_per_step_;
-  return position_scale_ *
-         Eigen::Vector3d(speed_m_s_ * std::cos(kappa * t),
-                         speed_m_s_ * std::sin(kappa * t),
-                         motion_.bob_m * M_PI / seconds_per_step_ *
-                             std::cos(M_PI * s + bob_phase_));
+  return position_scale_ * Eigen::Vector3d(speed_m_s_ * std::cos(kappa * t),
+                                           speed_m_s_ * std::sin(kappa * t),
+                                           bob_rate);
 }
 
 Eigen::Vector3d RigTrajectory::AngularVelocity(double t) const {

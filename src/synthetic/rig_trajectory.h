@@ -20,12 +20,22 @@
 // max_t yaw'(t) = (A_yaw 2 pi / P_yaw + |r_yaw|) / tau = max_turn_rate. The
 // profile keeps its amplitudes (how far the rig looks around) and its
 // pattern; the speed and the turn rate set how fast it is played.
+//
+// On a ground loop (ground_loop.h; a rendered scene's walk) the ground
+// point walks the loop instead, at speed v: at arc length v t, ellipse
+// parameter phi(t), and the body looks outward around phi:
+//   yaw(t) = phi(t) + A_yaw sin(2 pi s / P_yaw + phi_yaw)
+// (no steady turn r_yaw: the loop turns). The loop's own heading rate
+// phi'(t) = v dphi/ds peaks at v / min(a, b), so tau gives the swing the
+// rest: A_yaw 2 pi / P_yaw / tau = max_turn_rate - v / min(a, b).
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <random>
 
 #include "src/geometry/rigid3d.h"
+#include "src/synthetic/ground_loop.h"
 
 namespace rig_calibrator {
 
@@ -53,6 +63,14 @@ class RigTrajectory {
   RigTrajectory(const MotionProfile& motion, double speed_m_s,
                 double max_turn_rate_deg_s, bool rotation_only,
                 std::mt19937* rng);
+  // The trajectory on `loop` (above), at height motion.height_m; needs
+  // max_turn_rate_deg_s > LoopTurnRateDegS(loop, speed_m_s). Draws the same
+  // 4 phases.
+  RigTrajectory(const MotionProfile& motion, double speed_m_s,
+                double max_turn_rate_deg_s, const GroundLoop& loop,
+                std::mt19937* rng);
+  // The largest heading rate of walking `loop` at speed_m_s, deg/s.
+  static double LoopTurnRateDegS(const GroundLoop& loop, double speed_m_s);
 
   // The body pose at time t (seconds; any t, also negative).
   Rigid3d WorldFromBody(double t) const;
@@ -76,6 +94,7 @@ class RigTrajectory {
   Eigen::Vector3d PositionAt(double t) const;
 
   MotionProfile motion_;
+  std::optional<GroundLoop> loop_;
   double speed_m_s_ = 0;
   double seconds_per_step_ = 1;  // tau
   bool rotation_only_ = false;

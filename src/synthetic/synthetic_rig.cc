@@ -216,6 +216,19 @@ PresetDefinition DefinitionOf(const SyntheticRigOptions& options) {
     ReplicateStereoPair(options.stereo_num_pairs,
                         options.stereo_alternate_facing, &definition);
   }
+  if (options.image_height > 0) {
+    for (CameraSpec& spec : definition.cameras) {
+      colmap::Camera camera;
+      camera.SetModelIdFromName(spec.model_name);
+      camera.SetWidth(spec.width);
+      camera.SetHeight(spec.height);
+      camera.SetParams(spec.params);
+      camera.Rescale(static_cast<double>(options.image_height) / spec.height);
+      spec.width = static_cast<int>(camera.Width());
+      spec.height = static_cast<int>(camera.Height());
+      spec.params = camera.Params();
+    }
+  }
   return definition;
 }
 
@@ -368,6 +381,9 @@ bool SyntheticRigOptions::Check(std::string* error) const {
     message << "stereo_num_pairs must be 1..8 and stereo_num_pairs > 1 or "
                "stereo_alternate_facing need the stereo_pair preset, got "
             << stereo_num_pairs << " with " << RigPresetName(preset);
+  } else if (image_height != 0 && (image_height < 16 || image_height > 20000)) {
+    message << "image_height must be 0 or in [16, 20000] rows, got "
+            << image_height;
   } else if (!(map_scale > 0 && std::isfinite(map_scale))) {
     message << "map_scale must be a positive number, got " << map_scale;
   } else if (!(feature_window > 0 && feature_window <= 1)) {

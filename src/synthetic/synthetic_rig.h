@@ -102,6 +102,11 @@ struct SyntheticRigOptions {
   // i mod 5 and its focal lengths scaled by 1 + 0.03 * floor(i / 5). E.g. 10
   // for a 10-camera rig (runtime benchmark).
   int ring_num_cameras = 0;
+  // Every camera's image scaled to this many rows (0: the preset's sizes):
+  // width, focal lengths and principal point with it (colmap::Camera::
+  // Rescale), distortion unchanged, so each camera sees what it saw, more
+  // finely. E.g. 1080 for the rows a 1080p rolling shutter reads out.
+  int image_height = 0;
   // Map images (synthetic_map.h): how many, the Gaussian noise on their
   // observations (pixels per coordinate), and the error of the map points
   // given to the calibration (map units per coordinate, Gaussian): a map's

@@ -225,6 +225,8 @@ TEST(RenderCommand, CommandLineErrorsFailCleanly) {
 TEST(RenderCommand, TimeModelRendersEachImageAtItsCaptureTime) {
   SmallDataset dataset;
   dataset.options.time_model.frameset_rate_hz = 5;
+  // Slow enough for the room's small loop (rendered_dataset.h).
+  dataset.options.time_model.speed_m_s = 0.5;
   dataset.options.time_model.time_offsets_s = {0, 0.03};
   std::string error;
   ASSERT_TRUE(PlanRenderedDataset(dataset.options, &dataset.plan, &error))

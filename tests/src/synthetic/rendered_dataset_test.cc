@@ -137,7 +137,7 @@ TEST(RenderedDataset, RejectsInvalidOptions) {
 // The helmet with a time model at 5 Hz: offsets in +-50 ms, 20-30 us per row.
 RenderedDatasetOptions TimeModelOptions() {
   RenderedDatasetOptions options =
-      Options(RigPreset::kFisheyeHelmet5, SceneType::kRoom);
+      Options(RigPreset::kFisheyeHelmet5, SceneType::kCourtyard);
   options.num_framesets = 4;
   options.time_model.frameset_rate_hz = 5;
   options.time_model.max_time_offset_s = 0.05;
@@ -146,13 +146,17 @@ RenderedDatasetOptions TimeModelOptions() {
   return options;
 }
 
-// The trajectory is moved onto every planned pose: at t_f the rig is where
-// the plan puts it, and it turns at the trajectory's angular speed; images
-// are named by their capture times.
-TEST(RenderedDataset, TimeModelPassesThroughThePlannedPoses) {
+// The rig moves on one continuous trajectory: at t_f it is at
+// rig_from_world[f], it walks the courtyard's loop (0.65 times the walk
+// ellipse) at 1.5 m/s between framesets, its heading never turns faster than
+// 60 deg/s, and images are named by their capture times. In the room the
+// loop alone turns too fast for 1.5 m/s and 60 deg/s: refused, naming the
+// courtyard.
+TEST(RenderedDataset, TimeModelFollowsOneTrajectoryThroughTheFramesets) {
   RenderedDatasetPlan plan;
   std::string error;
-  const RenderedDatasetOptions options = TimeModelOptions();
+  RenderedDatasetOptions options = TimeModelOptions();
+  options.num_framesets = 20;
   ASSERT_TRUE(PlanRenderedDataset(options, &plan, &error)) << error;
   ASSERT_TRUE(plan.HasTimeModel());
   const RigGroundTruth& rig = plan.rig;
@@ -165,6 +169,8 @@ TEST(RenderedDataset, TimeModelPassesThroughThePlannedPoses) {
   }
   EXPECT_NE(rig.time_offsets_s[1], 0);
   EXPECT_EQ(plan.TimestampTolerance(), 1e8);  // half of 200 ms, in ns
+  const SceneWalk& walk = plan.scene.walk();
+  const Rigid3d rig_from_body = rig.body_from_rig.Inverse();
   for (int f = 0; f < options.num_framesets; ++f) {
     const double time_s = (f + 1) / 5.0;
     EXPECT_DOUBLE_EQ(rig.frameset_times_s[f], time_s);
@@ -173,24 +179,47 @@ TEST(RenderedDataset, TimeModelPassesThroughThePlannedPoses) {
       EXPECT_EQ(plan.RigImageName(c, f),
                 "cam" + std::to_string(c) + "/" +
                     Timestamp(time_s + rig.time_offsets_s[c]) + ".png");
-      const ImageCapture capture = plan.RigImageCapture(c, f);
       const Rigid3d planned = rig.cam_from_rig[c] * rig.rig_from_world[f];
-      const Rigid3d at_frameset_time = capture.CamFromWorldAt(time_s);
+      const Rigid3d at_frameset_time =
+          plan.RigImageCapture(c, f).CamFromWorldAt(time_s);
       EXPECT_LT(RotationDifferenceRad(at_frameset_time.rotation,
                                       planned.rotation),
                 1e-12);
       EXPECT_LT((at_frameset_time.translation - planned.translation).norm(),
                 1e-12);
     }
-    constexpr double kStep = 1e-4;
-    const ImageCapture capture = plan.RigImageCapture(0, f);
-    const double angular_speed =
-        RotationDifferenceRad(capture.CamFromWorldAt(time_s - kStep).rotation,
-                              capture.CamFromWorldAt(time_s + kStep).rotation) /
-        (2 * kStep);
-    EXPECT_NEAR(angular_speed, rig.trajectory->AngularVelocity(time_s).norm(),
-                1e-3 * angular_speed);
+    // The body (the cameras' mean centre) on the loop.
+    const Rigid3d world_from_body =
+        rig.rig_from_world[f].Inverse() * rig_from_body;
+    const Eigen::Vector2d on_unit_circle =
+        (world_from_body.translation.head<2>() - walk.center)
+            .cwiseQuotient(0.65 * walk.radii);
+    EXPECT_NEAR(on_unit_circle.norm(), 1, 1e-9);
+    if (f == 0) continue;
+    // A frameset period apart: 0.3 m of walk (a chord of it), and the
+    // heading turned by at most 60 deg/s * 0.2 s.
+    const Rigid3d previous =
+        rig.rig_from_world[f - 1].Inverse() * rig_from_body;
+    const double step_m =
+        (world_from_body.translation - previous.translation).head<2>().norm();
+    EXPECT_LT(step_m, 0.3 + 1e-9);
+    EXPECT_GT(step_m, 0.29);
+    const Eigen::Vector3d forward = world_from_body.rotation * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d previous_forward =
+        previous.rotation * Eigen::Vector3d::UnitX();
+    const double heading_step_deg =
+        std::abs(std::remainder(std::atan2(forward.y(), forward.x()) -
+                                    std::atan2(previous_forward.y(),
+                                               previous_forward.x()),
+                                2 * M_PI)) *
+        180 / M_PI;
+    EXPECT_LT(heading_step_deg, 12 + 1e-9) << f;
   }
+  options.scene = SceneType::kRoom;
+  EXPECT_FALSE(PlanRenderedDataset(options, &plan, &error));
+  EXPECT_NE(error.find("courtyard"), std::string::npos) << error;
+  options.time_model.speed_m_s = 0.5;  // 31.5 deg/s of the room's loop
+  EXPECT_TRUE(PlanRenderedDataset(options, &plan, &error)) << error;
   EXPECT_EQ(Timestamp(1.2), "1200000000");
   // Without a time model: no times, the frameset names of earlier versions.
   ASSERT_TRUE(PlanRenderedDataset(

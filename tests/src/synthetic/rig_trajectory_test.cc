@@ -90,6 +90,69 @@ TEST(RigTrajectory, VelocitiesAreTheDerivativesOfThePoses) {
   }
 }
 
+// On a ground loop (the rendered rig's walk, the courtyard's proportions):
+// over 30 s (more than a lap) the body stays on the ellipse at its height
+// plus the bob, at the requested ground speed; the heading rate never
+// exceeds the requested turn rate and comes within 5 % of it; the
+// velocities are the derivatives of the poses; the body looks outward
+// within the swing's amplitude.
+TEST(RigTrajectory, LoopWalkIsOnTheEllipseAtSpeedAndTurnRate) {
+  const Eigen::Vector2d center(0.5, -1), radii(4.2, 3.9);
+  const GroundLoop loop(center, radii, 1.1);
+  MotionProfile profile =
+      MakePresetDefinition(RigPreset::kFisheyeHelmet5, 0).motion;
+  profile.height_m = 1.4;
+  const double speed = 1.5, turn_rate_deg = 60;
+  ASSERT_LT(RigTrajectory::LoopTurnRateDegS(loop, speed), turn_rate_deg);
+  std::mt19937 rng(5);
+  const RigTrajectory trajectory(profile, speed, turn_rate_deg, loop, &rng);
+  const double h = 1e-4;
+  double max_speed_error = 0, max_heading_rate_deg = 0, max_off_ellipse = 0;
+  double max_outward_deg = 0;
+  for (double t = 0; t < 30; t += 2e-3) {
+    const Rigid3d pose = trajectory.WorldFromBody(t);
+    const Eigen::Vector2d ground =
+        (pose.translation.head<2>() - center).cwiseQuotient(radii);
+    max_off_ellipse = std::max(max_off_ellipse, std::abs(ground.norm() - 1));
+    EXPECT_LE(std::abs(pose.translation.z() - 1.4), profile.bob_m + 1e-12);
+    const Rigid3d before = trajectory.WorldFromBody(t - h);
+    const Rigid3d after = trajectory.WorldFromBody(t + h);
+    max_speed_error = std::max(
+        max_speed_error,
+        std::abs((after.translation - before.translation).head<2>().norm() /
+                     (2 * h) -
+                 speed));
+    max_heading_rate_deg = std::max(
+        max_heading_rate_deg,
+        std::abs(WrapAngle(HeadingOf(after) - HeadingOf(before)) / (2 * h)) *
+            180 / M_PI);
+    max_outward_deg = std::max(
+        max_outward_deg,
+        std::abs(WrapAngle(HeadingOf(pose) - std::atan2(ground.y(),
+                                                        ground.x()))) *
+            180 / M_PI);
+    if (std::fmod(t, 0.37) < 2e-3) {
+      const Eigen::Vector3d linear =
+          (after.translation - before.translation) / (2 * h);
+      EXPECT_LT((linear - trajectory.LinearVelocity(t)).norm(), 1e-6) << t;
+      const Eigen::AngleAxisd step(after.rotation * before.rotation.inverse());
+      EXPECT_LT((step.angle() * step.axis() / (2 * h) -
+                 trajectory.AngularVelocity(t))
+                    .norm(),
+                1e-6)
+          << t;
+    }
+  }
+  EXPECT_LT(max_off_ellipse, 1e-12);
+  EXPECT_LT(max_speed_error, 1e-6 * speed);
+  EXPECT_LT(max_heading_rate_deg, turn_rate_deg * (1 + 1e-6));
+  EXPECT_GT(max_heading_rate_deg, turn_rate_deg * 0.95);
+  // The heading is the ellipse parameter (the angle of the ground point
+  // scaled to the unit circle) plus the swing.
+  EXPECT_LT(max_outward_deg, profile.yaw_amplitude_deg + 1e-9);
+  EXPECT_GT(max_outward_deg, profile.yaw_amplitude_deg * 0.9);
+}
+
 // rotation_only keeps the position of t = 0; ScalePositions scales every
 // position and velocity and no rotation; the same seed gives the same
 // trajectory.

@@ -458,6 +458,58 @@ TEST(SyntheticRig, SelectFramesetsKeepsTheChosenOnes) {
   }
 }
 
+// image_height scales every preset camera to that many rows: width, focal
+// lengths and principal point by the same factor, distortion unchanged (a
+// pixel's ray is the same up to the factor), observations inside the larger
+// images and exact; 0 and out-of-range values are refused or ignored.
+TEST(SyntheticRig, ImageHeightScalesEveryCamera) {
+  for (const RigPreset preset : AllRigPresets()) {
+    SCOPED_TRACE(RigPresetName(preset));
+    SyntheticRigOptions options = SmallOptions(preset);
+    options.noise_px = 0;
+    options.outlier_ratio = 0;
+    const SyntheticRig original = GenerateSyntheticRig(options);
+    options.image_height = 1080;
+    const SyntheticRig scaled = GenerateSyntheticRig(options);
+    ASSERT_EQ(scaled.truth.cameras.size(), original.truth.cameras.size());
+    for (size_t c = 0; c < scaled.truth.cameras.size(); ++c) {
+      const colmap::Camera& before = original.truth.cameras[c];
+      const colmap::Camera& after = scaled.truth.cameras[c];
+      const double factor = 1080.0 / before.Height();
+      EXPECT_EQ(after.Height(), 1080u);
+      EXPECT_EQ(after.Width(), std::round(factor * before.Width()));
+      EXPECT_EQ(after.ModelId(), before.ModelId());
+      EXPECT_NEAR(after.MeanFocalLength(),
+                  factor * before.MeanFocalLength(), 1e-9 * factor * 1000);
+      // The same ray through corresponding pixels (up to the rounding of
+      // the width, below 1e-3 of a pixel's share).
+      const Eigen::Vector2d pixel(0.3 * before.Width(), 0.7 * before.Height());
+      EXPECT_LT((after.ImageToWorld(factor * pixel) -
+                 before.ImageToWorld(pixel))
+                    .norm(),
+                2e-3);
+      EXPECT_EQ(scaled.dataset.cameras[c].camera.Height(), 1080u);
+    }
+    double max_error = 0;
+    for (const RigImage& image : scaled.dataset.images) {
+      const colmap::Camera& camera = scaled.truth.cameras[image.camera_index];
+      for (const Correspondence& correspondence : image.correspondences) {
+        max_error = std::max(max_error, TrueReprojectionError(
+                                            scaled, image, correspondence));
+        EXPECT_GE(correspondence.point2D.y(), 0);
+        EXPECT_LE(correspondence.point2D.y(), camera.Height());
+        EXPECT_LE(correspondence.point2D.x(), camera.Width());
+      }
+    }
+    EXPECT_LT(max_error, 1e-9);
+  }
+  SyntheticRigOptions options;
+  std::string error;
+  options.image_height = 8;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("image_height"), std::string::npos) << error;
+}
+
 TEST(SyntheticRig, InvalidOptionsGiveNoImages) {
   SyntheticRigOptions options;
   std::string error;
