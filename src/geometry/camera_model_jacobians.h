@@ -298,4 +298,37 @@ void ProjectWithJacobians(const double* params, double u, double v,
   }
 }
 
+// The reprojection residual r = pi_theta(p_x / p_z, p_y / p_z) - observed of
+// a point p in the camera frame, and, with `d_pixel_d_cam` given, its
+// Jacobian over p,
+//   dr/dp = dpi/d(u,v) [1/z, 0, -u/z; 0, 1/z, -v/z],
+// and over theta into `d_pixel_d_params` (when given). False, nothing
+// written, for a point not in front of the camera (p_z <= 0): an invalid
+// evaluation for the solvers, not a NaN. The rig costs' shared last step
+// (rig_reprojection_cost.h, timed_rig_reprojection_cost.h).
+template <typename CameraModel>
+bool ProjectCameraPoint(const double* params, const Eigen::Vector3d& point_in_cam,
+                        const Eigen::Vector2d& observed, double* residuals,
+                        Eigen::Matrix<double, 2, 3>* d_pixel_d_cam,
+                        double* d_pixel_d_params) {
+  const double z = point_in_cam.z();
+  if (!(z > 0)) return false;
+  const double u = point_in_cam.x() / z;
+  const double v = point_in_cam.y() / z;
+  if (d_pixel_d_cam == nullptr) {
+    CameraModel::WorldToImage(params, u, v, &residuals[0], &residuals[1]);
+  } else {
+    Eigen::Matrix2d d_pixel_d_uv;
+    ProjectWithJacobians<CameraModel>(params, u, v, residuals, &d_pixel_d_uv,
+                                      d_pixel_d_params);
+    d_pixel_d_cam->col(0) = d_pixel_d_uv.col(0) / z;
+    d_pixel_d_cam->col(1) = d_pixel_d_uv.col(1) / z;
+    d_pixel_d_cam->col(2) =
+        -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
+  }
+  residuals[0] -= observed.x();
+  residuals[1] -= observed.y();
+  return true;
+}
+
 }  // namespace rig_calibrator

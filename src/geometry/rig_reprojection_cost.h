@@ -101,31 +101,17 @@ class RigReprojectionCost final : public TangentJacobianCost {
     const Eigen::Vector3d cam_rotated = cam_rotation_matrix * point_in_rig;
     const Eigen::Vector3d point_in_cam =
         cam_rotated + Eigen::Vector3d(cam_from_rig + 4);
-    const double z = point_in_cam.z();
-    if (!(z > 0)) {
+    if (jacobians == nullptr) {
+      return ProjectCameraPoint<CameraModel>(camera_params, point_in_cam,
+                                             observed_, residuals, nullptr,
+                                             nullptr);
+    }
+    Eigen::Matrix<double, 2, 3> d_pixel_d_cam;
+    if (!ProjectCameraPoint<CameraModel>(camera_params, point_in_cam,
+                                         observed_, residuals, &d_pixel_d_cam,
+                                         jacobians[2])) {
       return false;
     }
-    const double u = point_in_cam.x() / z;
-    const double v = point_in_cam.y() / z;
-    if (jacobians == nullptr) {
-      CameraModel::WorldToImage(camera_params, u, v, &residuals[0],
-                                &residuals[1]);
-      residuals[0] -= observed_.x();
-      residuals[1] -= observed_.y();
-      return true;
-    }
-
-    Eigen::Matrix2d d_pixel_d_uv;
-    ProjectWithJacobians<CameraModel>(camera_params, u, v, residuals,
-                                      &d_pixel_d_uv, jacobians[2]);
-    residuals[0] -= observed_.x();
-    residuals[1] -= observed_.y();
-
-    Eigen::Matrix<double, 2, 3> d_pixel_d_cam;
-    d_pixel_d_cam.col(0) = d_pixel_d_uv.col(0) / z;
-    d_pixel_d_cam.col(1) = d_pixel_d_uv.col(1) / z;
-    d_pixel_d_cam.col(2) =
-        -(u * d_pixel_d_uv.col(0) + v * d_pixel_d_uv.col(1)) / z;
     if (jacobians[1] != nullptr) {
       WritePoseJacobian<kTangent, 2>(d_pixel_d_cam, cam_rotation,
                                      point_in_rig, cam_rotated, jacobians[1]);

@@ -74,7 +74,7 @@ COLMAP="$colmap" bash "$repo/scripts/calibrate_rig.sh" "$demo/map/database.db" \
   fail "calibrating the synchronized twin (log: $work/synchronized_calibration.log)"
 
 # 1. The time model.
-python3 "$repo/tests/e2e/check_time_model.py" \
+/usr/bin/python3 "$repo/tests/e2e/check_time_model.py" \
   "$demo/rig/calibration/calibration_summary.json" "$truth/time_model.json" 0.5 5 ||
   fail "the capture-time model is not within 0.5 ms and 5 %"
 
@@ -85,7 +85,7 @@ for run in demo synchronized; do
     --calibration_path "$folder/rig/calibration" --output_path "$work/errors_$run.json" \
     > "$work/evaluate_$run.log" || fail "evaluate ($run)"
 done
-python3 - "$work/errors_demo.json" "$work/errors_synchronized.json" << 'PYTHON' || fail "the time model's rig is less accurate than 1.25 times the synchronized one's"
+/usr/bin/python3 - "$work/errors_demo.json" "$work/errors_synchronized.json" << 'PYTHON' || fail "the time model's rig is less accurate than 1.25 times the synchronized one's"
 import json, sys
 timed, synchronized = (json.load(open(path))["cameras"] for path in sys.argv[1:3])
 failed = False
