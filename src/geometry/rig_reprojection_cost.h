@@ -50,7 +50,8 @@ namespace rig_calibrator {
 // r = pi_theta(P Q X) - x for the COLMAP model CameraModel (see the top of
 // the file); X is a fixed point given at construction or the fourth block.
 template <typename CameraModel>
-class RigReprojectionCost final : public TangentJacobianCost {
+class RigReprojectionCost final
+    : public RigPosesTangentCost<RigReprojectionCost<CameraModel>> {
  public:
   static constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
 
@@ -60,27 +61,15 @@ class RigReprojectionCost final : public TangentJacobianCost {
       : observed_(observed),
         fixed_point3D_(point3D != nullptr ? *point3D : Eigen::Vector3d::Zero()),
         variable_point_(point3D == nullptr) {
-    set_num_residuals(2);
+    this->set_num_residuals(2);
     // One allocation: a cost is made per observation (10^6).
-    *mutable_parameter_block_sizes() =
+    *this->mutable_parameter_block_sizes() =
         variable_point_ ? std::vector<int32_t>{7, 7, kNumParams, 3}
                         : std::vector<int32_t>{7, 7, kNumParams};
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    return EvaluateImpl</*kTangent=*/false>(parameters, residuals, jacobians);
-  }
-  // The poses' Jacobians 2 x 6 in RigPoseManifold's tangent space.
-  int TangentSize(int parameter_block) const override {
-    return parameter_block < 2 ? 6 : 0;
-  }
-  bool EvaluateTangent(double const* const* parameters, double* residuals,
-                       double** jacobians) const override {
-    return EvaluateImpl</*kTangent=*/true>(parameters, residuals, jacobians);
-  }
-
- private:
+  // Evaluate and EvaluateTangent (RigPosesTangentCost): the poses'
+  // Jacobians ambient, or 2 x 6 in RigPoseManifold's tangent space.
   template <bool kTangent>
   bool EvaluateImpl(double const* const* parameters, double* residuals,
                     double** jacobians) const {
@@ -130,6 +119,7 @@ class RigReprojectionCost final : public TangentJacobianCost {
     return true;
   }
 
+ private:
   const Eigen::Vector2d observed_;
   const Eigen::Vector3d fixed_point3D_;
   const bool variable_point_;

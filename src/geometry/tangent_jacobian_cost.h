@@ -24,4 +24,28 @@ class TangentJacobianCost : public ceres::CostFunction {
                                double* residuals, double** jacobians) const = 0;
 };
 
+// A rig cost whose blocks 0 and 1 are poses (rig_from_world,
+// cam_from_rig) on RigPoseManifold (tangent size 6), the others ambient:
+// Evaluate and EvaluateTangent are Derived's one
+//   template <bool kTangent> bool EvaluateImpl(parameters, residuals,
+//                                              jacobians) const
+// (rig_reprojection_cost.h, timed_rig_reprojection_cost.h).
+template <typename Derived>
+class RigPosesTangentCost : public TangentJacobianCost {
+ public:
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return static_cast<const Derived*>(this)->template EvaluateImpl<false>(
+        parameters, residuals, jacobians);
+  }
+  int TangentSize(int parameter_block) const override {
+    return parameter_block < 2 ? 6 : 0;
+  }
+  bool EvaluateTangent(double const* const* parameters, double* residuals,
+                       double** jacobians) const override {
+    return static_cast<const Derived*>(this)->template EvaluateImpl<true>(
+        parameters, residuals, jacobians);
+  }
+};
+
 }  // namespace rig_calibrator

@@ -16,7 +16,8 @@ namespace {
 // r = pi_theta(P Exp(-u(tau)) (Q X - p(tau))) - x with the Jacobians of the
 // header.
 template <typename CameraModel>
-class TimedRigReprojectionCost final : public TangentJacobianCost {
+class TimedRigReprojectionCost final
+    : public RigPosesTangentCost<TimedRigReprojectionCost<CameraModel>> {
  public:
   static constexpr int kNumParams = static_cast<int>(CameraModel::kNumParams);
 
@@ -27,25 +28,14 @@ class TimedRigReprojectionCost final : public TangentJacobianCost {
         fixed_point3D_(point3D != nullptr ? *point3D : Eigen::Vector3d::Zero()),
         variable_point_(point3D == nullptr),
         motion_(motion) {
-    set_num_residuals(2);
-    *mutable_parameter_block_sizes() =
+    this->set_num_residuals(2);
+    *this->mutable_parameter_block_sizes() =
         variable_point_ ? std::vector<int32_t>{7, 7, kNumParams, 1, 1, 3}
                         : std::vector<int32_t>{7, 7, kNumParams, 1, 1};
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    return EvaluateImpl</*kTangent=*/false>(parameters, residuals, jacobians);
-  }
-  int TangentSize(int parameter_block) const override {
-    return parameter_block < 2 ? 6 : 0;
-  }
-  bool EvaluateTangent(double const* const* parameters, double* residuals,
-                       double** jacobians) const override {
-    return EvaluateImpl</*kTangent=*/true>(parameters, residuals, jacobians);
-  }
-
- private:
+  // Evaluate and EvaluateTangent (RigPosesTangentCost): the poses'
+  // Jacobians ambient, or 2 x 6 in RigPoseManifold's tangent space.
   template <bool kTangent>
   bool EvaluateImpl(double const* const* parameters, double* residuals,
                     double** jacobians) const {
@@ -126,6 +116,7 @@ class TimedRigReprojectionCost final : public TangentJacobianCost {
     return true;
   }
 
+ private:
   const Eigen::Vector2d observed_;
   const Eigen::Vector3d fixed_point3D_;
   const bool variable_point_;
