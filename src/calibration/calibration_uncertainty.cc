@@ -23,6 +23,7 @@
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/geometry/frameset_motion.h"
+#include "src/geometry/frameset_velocity_prior_cost.h"
 #include "src/geometry/pose_jacobians.h"
 #include "src/geometry/rig_reprojection_cost.h"
 #include "src/geometry/tangent_jacobian_cost.h"
@@ -104,6 +105,7 @@ struct Observation {
   // delay (its camera's).
   double* time_offset = nullptr;
   double* line_delay = nullptr;
+  double* velocity = nullptr;  // its frameset's (frameset_motion.h)
   int map_camera = -1;  // a map image's camera
   // The cluster of the between-framesets covariance: the frameset of a rig
   // image, num_framesets + m for map image m.
@@ -231,6 +233,13 @@ class UncertaintyProblem {
   // as in the adjustment.
   std::vector<double> time_offsets_, line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
+  // Per frameset the estimated velocity (the result's, else the motion's
+  // p1), a parameter in its rig pose's block, with its prior as in the
+  // adjustment: the scale, the costs, and per prior residual its frameset.
+  std::vector<Eigen::Vector3d> velocities_;
+  double velocity_prior_sigma_ = 1;
+  std::vector<std::unique_ptr<ceres::CostFunction>> velocity_prior_costs_;
+  std::vector<std::pair<int, size_t>> velocity_priors_;
   LargeVector<Observation> observations_;  // 10^6: huge_page_allocator.h
   std::vector<int64_t> point_ids_;  // refined points in the problem
   std::unordered_map<int64_t, int> point_index_;
@@ -310,6 +319,16 @@ bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
     *error = "the time model's frameset motions: " + *error;
     return false;
   }
+  velocities_ = calibration_.rig_velocities;
+  if (velocities_.size() != frameset_motions_.size()) {
+    velocities_.clear();
+    for (const FramesetMotion& motion : frameset_motions_) {
+      velocities_.emplace_back(motion[9], motion[10], motion[11]);
+    }
+  }
+  // The scale the adjustment's next solve would take.
+  velocity_prior_sigma_ = FramesetVelocityPriorSigma(
+      frameset_motions_, velocities_, calibration_.rig_from_world);
   return true;
 }
 
@@ -357,6 +376,7 @@ void UncertaintyProblem::CollectObservations() {
       if (!frameset_motions_.empty()) {
         observation.time_offset = &time_offsets_[c];
         observation.line_delay = &line_delays_[c];
+        observation.velocity = velocities_[image.frameset_index].data();
       }
       const auto refined =
           calibration_.refined_points3D.find(correspondence.point3D_id);
@@ -457,7 +477,9 @@ void UncertaintyProblem::AssignBlocks() {
   for (const Observation& observation : observations_) {
     if (observation.rig_camera >= 0) {
       if (options_.refine_rig_poses) {
-        AddBlock(6, &rig_pose_block_, observation.cluster);
+        // With the time model the frameset's velocity (3) follows its pose.
+        AddBlock(frameset_motions_.empty() ? 6 : 9, &rig_pose_block_,
+                 observation.cluster);
       }
       camera_observed[observation.rig_camera] = 1;
     } else if (options_.refine_map) {
@@ -542,6 +564,10 @@ void UncertaintyProblem::AddParameterBlocks() {
     if (rig_pose_block_[f] < 0) continue;
     solver_->AddParameterBlock(rig_from_world_[f].data(), 7, &pose_manifold_,
                                rig_pose_block_[f]);
+    if (!frameset_motions_.empty()) {
+      solver_->AddParameterBlock(velocities_[f].data(), 3, nullptr,
+                                 rig_pose_block_[f]);
+    }
   }
   for (size_t m = 0; m < map_pose_block_.size(); ++m) {
     if (map_pose_block_[m] < 0) continue;
@@ -618,10 +644,24 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
     if (observation.time_offset != nullptr) {
       parameters.push_back(observation.time_offset);
       parameters.push_back(observation.line_delay);
+      parameters.push_back(observation.velocity);
     }
     if (refined) parameters.push_back(points_[observation.point_index].data());
     observation.residual = solver_->AddResidualBlock(
         residual_costs_[k].get(), nullptr, parameters);
+  }
+  for (size_t f = 0; f < rig_pose_block_.size() && !frameset_motions_.empty();
+       ++f) {
+    if (rig_pose_block_[f] < 0) continue;
+    for (const int first_axis : {0, 2}) {
+      velocity_prior_costs_.push_back(
+          std::make_unique<FramesetVelocityPriorCost>(
+              &frameset_motions_[f], &velocity_prior_sigma_, first_axis));
+      velocity_priors_.emplace_back(
+          static_cast<int>(f),
+          solver_->AddResidualBlock(velocity_prior_costs_.back().get(), nullptr,
+                                    {velocities_[f].data()}));
+    }
   }
   if (!solver_->LinearizeGaussNewton(error)) return false;
   information_ = solver_->ReducedMatrix().selfadjointView<Eigen::Upper>();
@@ -732,10 +772,12 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
   Eigen::MatrixXd schur =
       information_.bottomRightCorner(num_c_, num_c_).toDense();
   if (num_o_ > 0) {
-    if (!(diagonal_o.minCoeff() > 0)) {
-      result->message =
-          "a rig or map pose has no information (no observation constrains "
-          "it): the uncertainty is undetermined";
+    Eigen::Index least = 0;
+    if (!(diagonal_o.minCoeff(&least) > 0)) {
+      result->message = DescribeNuisanceParameter(static_cast<int>(least)) +
+                        " has no usable information (no observation "
+                        "constrains it, or its information is not a "
+                        "positive number): the uncertainty is undetermined";
       return false;
     }
     scale_o_ = diagonal_o.cwiseSqrt().cwiseInverse();
@@ -905,6 +947,12 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
   for (size_t o = 0; o < observations_.size(); ++o) {
     by_cluster[observations_[o].cluster].push_back(static_cast<int>(o));
   }
+  // A frameset's velocity priors are part of its score, unweighted (no
+  // robust loss).
+  std::vector<std::vector<size_t>> priors_by_cluster(num_clusters);
+  for (const auto& [frameset, residual] : velocity_priors_) {
+    priors_by_cluster[frameset].push_back(residual);
+  }
   std::vector<int> clusters;
   for (int g = 0; g < num_clusters; ++g) {
     if (!by_cluster[g].empty()) clusters.push_back(g);
@@ -929,6 +977,9 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
       if (observation.point_index >= 0) {
         point_scores.emplace_back(observation.point_index, point_score);
       }
+    }
+    for (const size_t residual : priors_by_cluster[clusters[g]]) {
+      solver_->AddGradient(residual, 1.0, &score);
     }
     double anchor = anchored ? anchor_v_.dot(score) : 0;
     Eigen::VectorXd reduced = score;

@@ -40,6 +40,7 @@ AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
     CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
                                  calibration.rig_from_world, &motions, &error))
         << error << " (the capture-time model ran on these poses)";
+    UseFramesetVelocities(calibration.rig_velocities, &motions);
     const CameraCaptureTime& time = time_model.cameras[camera_index];
     offset = time_model.time_offsets_kept ? time.time_offset_s : 0;
     line_delay = time_model.line_delays_kept ? time.line_delay_s : 0;
@@ -71,7 +72,8 @@ AdjustedCameraRows AdjustedRowsOf(const RigDataset& dataset,
                                             correspondence.point2D.y());
         Eigen::Vector3d point_rig;
         WorldToRigAtOffset(pose.data(), point.data(),
-                           motions[image.frameset_index], tau,
+                           motions[image.frameset_index],
+                           &motions[image.frameset_index][9], tau,
                            point_rig.data());
         rows.points_rig.push_back(point_rig);
       } else {

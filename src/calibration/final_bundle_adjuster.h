@@ -20,7 +20,11 @@
 // rig's motion M_f around t_f to third order in tau (frameset_motion.h:
 // why this form and order), its coefficients from the current rig poses,
 // held within a solve and recomputed before each (the cost:
-// timed_rig_reprojection_cost.h). delta_c are refined for the non-reference
+// timed_rig_reprojection_cost.h), except the translational velocity v_f:
+// a parameter of each frameset, in its pose's block row, with a weak prior
+// towards the polynomial's (frameset_velocity_prior_cost.h), because the
+// images see it and the frameset poses at 5 Hz do not (a walk's bob).
+// delta_c are refined for the non-reference
 // cameras (delta_ref = 0 defines the rig's clock), rho_c for every camera
 // (a rolling shutter's line delay is observable for the reference camera
 // too). After the last solve the motion is recomputed once more and the
@@ -104,8 +108,12 @@ struct FinalBundleAdjustmentOptions {
   //    periphery has larger but consistent errors, keeps its periphery while a
   //    pinhole camera of the same rig is pruned at its own tighter level;
   //  - or its point is behind the camera;
-  //  - or its depth exceeds max_depth_factor * the median depth of all
-  //    observations (scene-scale relative: no map units are hard-coded).
+  //  - or its depth exceeds max_depth_factor * the median depth of the rig
+  //    observations, or is below that median / max_depth_factor (a point
+  //    that collapsed onto a camera's centre: on EuRoC's map a refined
+  //    point at 1e-7 of a map image's centre fitted its observations and
+  //    gave that pose 1e26 of information, which left the uncertainty
+  //    undetermined) (scene-scale relative: no map units are hard-coded).
   // The last two tests also run before the first solve, so that no residual
   // is ever evaluated behind a camera.
   double min_outlier_error_px = 2.0;

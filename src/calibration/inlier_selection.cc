@@ -70,6 +70,7 @@ void SelectFullInliers(const RigDataset& dataset, double max_error_px,
     CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
                                  calibration->rig_from_world, &motions, &error))
         << error;
+    UseFramesetVelocities(calibration->rig_velocities, &motions);
   }
   const auto at = [](const std::vector<double>& values, int camera) {
     return values.empty() ? 0.0 : values[camera];
@@ -91,7 +92,8 @@ void SelectFullInliers(const RigDataset& dataset, double max_error_px,
               at(line_delays_s, image.camera_index), correspondence.point2D.y());
           Eigen::Vector3d point_rig;
           WorldToRigAtOffset(rig_from_world.data(), point.data(),
-                             motions[image.frameset_index], tau,
+                             motions[image.frameset_index],
+                             &motions[image.frameset_index][9], tau,
                              point_rig.data());
           point_cam = calibration->cam_from_rig[image.camera_index] * point_rig;
         } else {

@@ -448,8 +448,7 @@ void RunCaptureTiming(const PipelineOptions& options, const RigDataset& dataset,
     timing = CaptureTiming();
     timing.computed = true;
     timing.error =
-        "not measured: the final adjustment's time model estimated the "
-        "offsets";
+        "the final adjustment's time model estimated the offsets";
     if (options.print_progress) {
       std::cout << "  "
                 << CaptureTimingLine(names, dataset.reference_camera, timing)

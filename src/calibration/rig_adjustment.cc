@@ -50,6 +50,12 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
                        ? std::vector<double>(num_cameras, 0.0)
                        : options.initial_line_delays_s;
     frameset_motions_.resize(rig_from_world_.size());
+    frameset_velocities_.assign(rig_from_world_.size(),
+                                Eigen::Vector3d::Zero());
+    if (calibration.rig_velocities.size() == rig_from_world_.size()) {
+      frameset_velocities_ = calibration.rig_velocities;
+      velocities_started_ = true;
+    }
     UpdateFramesetMotions();
   }
   // Without use_map_observations the map images are still evaluated after
@@ -131,7 +137,8 @@ RigAdjustment::ObservationError RigAdjustment::Evaluate(
     Eigen::Vector3d point_in_rig;
     WorldToRigAtOffset(rig_from_world_[image.frameset_index].data(),
                        PointOf(observation).data(),
-                       frameset_motions_[image.frameset_index], tau,
+                       frameset_motions_[image.frameset_index],
+                       frameset_velocities_[image.frameset_index].data(), tau,
                        point_in_rig.data());
     point_in_cam = FromPoseParams(cam_from_rig_[image.camera_index]) *
                    point_in_rig;
@@ -374,6 +381,7 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
           FromPoseParams(rig_from_world_[frameset]);
     }
   }
+  calibration->rig_velocities = frameset_velocities_;
   for (size_t i = 0; i < dataset_.images.size(); ++i) {
     ImageResult& result = calibration->images[i];
     result.inlier_mask.assign(dataset_.images[i].correspondences.size(), 0);

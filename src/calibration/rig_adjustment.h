@@ -11,6 +11,7 @@
 #include <ceres/ceres.h>
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -103,8 +104,12 @@ class RigAdjustment {
   using SlotErrors = LargeVector<std::pair<int, ObservationError>>;
 
   // With a time model: the frameset motions (frameset_motion.h) from the
-  // current rig poses, before each solve.
+  // current rig poses and the velocity prior's scale, before each solve;
+  // at the first call the velocities start at the motions' p1 unless given.
   void UpdateFramesetMotions();
+  // The velocity priors (FramesetVelocityPriorCost) of the framesets whose
+  // pose and velocity are refined, after the observations' residuals.
+  void AddVelocityPriors(const std::vector<char>& frameset_refined);
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
@@ -143,6 +148,17 @@ class RigAdjustment {
   void HoldPointsNoLongerRefined(
       const std::vector<int64_t>& refined_ids,
       const std::vector<std::pair<int64_t, size_t>>& rig_ids);
+  // The depths an observation may have (final_bundle_adjuster.h's pruning
+  // rules): within max_depth_factor of the median depth of the rig
+  // observations in `errors` (EvaluateWithSlots with them first), either
+  // way; any positive depth without rig observations.
+  struct DepthRange {
+    double min = 0, max = std::numeric_limits<double>::infinity();
+    bool Contains(double depth) const {
+      return depth > 0 && depth >= min && depth <= max;
+    }
+  };
+  DepthRange DepthRangeOf(const SlotErrors& errors) const;
   // Per slot (rig cameras, then map cameras), max(min_outlier_error_px,
   // outlier_sigma_factor * sigma), sigma the robust spread of the residual
   // components of the slot's observations in front of their camera.
@@ -166,10 +182,16 @@ class RigAdjustment {
   std::vector<PoseParams> rig_from_world_;
   std::vector<bool> has_rig_pose_;
   // The time model (empty without): per camera its offset and line delay,
-  // per frameset its motion (sized once: the costs point into it).
+  // per frameset its motion from the poses (sized once: the costs point
+  // into it) and its estimated translational velocity, which replaces the
+  // motion's p1 (frameset_motion.h); the velocities' prior scale and costs.
   std::vector<double> time_offsets_;
   std::vector<double> line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
+  std::vector<Eigen::Vector3d> frameset_velocities_;
+  bool velocities_started_ = false;
+  double velocity_prior_sigma_ = 1;
+  std::vector<std::unique_ptr<ceres::CostFunction>> velocity_prior_costs_;
   LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;
   // The map images (empty unless refine_points and map images):

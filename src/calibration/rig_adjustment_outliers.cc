@@ -19,20 +19,14 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
       MapObservationsInProblem();
   const SlotErrors errors =
       EvaluateWithSlots(/*with_rig_observations=*/true, map_observations);
-  std::vector<double> depths;
-  depths.reserve(observations_.size());
-  for (size_t k = 0; k < observations_.size(); ++k) {
-    if (errors[k].second.depth > 0) depths.push_back(errors[k].second.depth);
-  }
-  const double max_depth =
-      depths.empty() ? 0 : options_.max_depth_factor * colmap::Median(depths);
+  const DepthRange depth_range = DepthRangeOf(errors);
   std::vector<double> max_error_px(cameras_.size() + map_cameras_.size(),
                                    std::numeric_limits<double>::infinity());
   if (prune_residuals) {
     max_error_px = MaxErrorPerSlot(errors);
   }
   const auto fits = [&](const std::pair<int, ObservationError>& error) {
-    return error.second.depth > 0 &&
+    return depth_range.Contains(error.second.depth) &&
            error.second.residual.norm() <= max_error_px[error.first];
   };
   // Compacted in place, in their order: a new list would be 36 MB of fresh
@@ -40,7 +34,7 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
   const size_t num_rig = observations_.size();
   size_t num_kept = 0;
   for (size_t k = 0; k < num_rig; ++k) {
-    if (fits(errors[k]) && errors[k].second.depth <= max_depth) {
+    if (fits(errors[k])) {
       if (num_kept != k) observations_[num_kept] = std::move(observations_[k]);
       ++num_kept;
     }
@@ -62,13 +56,18 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
 size_t RigAdjustment::RejectMapOutliers() {
   const std::vector<MapObservationRef> map_observations =
       MapObservationsOfRefinedPoints();
+  // The rig observations too, for the depth range; their thresholds are
+  // those of RejectOutliers' last call.
   const SlotErrors errors =
-      EvaluateWithSlots(/*with_rig_observations=*/false, map_observations);
+      EvaluateWithSlots(/*with_rig_observations=*/true, map_observations);
+  const DepthRange depth_range = DepthRangeOf(errors);
   const std::vector<double> max_error_px = MaxErrorPerSlot(errors);
+  const size_t num_rig = observations_.size();
   size_t num_rejected = 0;
   for (size_t k = 0; k < map_observations.size(); ++k) {
-    const auto& [slot, error] = errors[k];
-    if (!(error.depth > 0 && error.residual.norm() <= max_error_px[slot])) {
+    const auto& [slot, error] = errors[num_rig + k];
+    if (!(depth_range.Contains(error.depth) &&
+          error.residual.norm() <= max_error_px[slot])) {
       map_rejected_[map_observations[k].image]
                    [map_observations[k].observation] = 1;
       ++num_rejected;
@@ -77,6 +76,22 @@ size_t RigAdjustment::RejectMapOutliers() {
   num_map_rejected_ += num_rejected;
   if (num_rejected > 0) selection_current_ = false;
   return num_rejected;
+}
+
+RigAdjustment::DepthRange RigAdjustment::DepthRangeOf(
+    const SlotErrors& errors) const {
+  std::vector<double> depths;
+  depths.reserve(observations_.size());
+  for (size_t k = 0; k < observations_.size(); ++k) {
+    if (errors[k].second.depth > 0) depths.push_back(errors[k].second.depth);
+  }
+  DepthRange range;
+  if (!depths.empty()) {
+    const double median = colmap::Median(depths);
+    range.min = median / options_.max_depth_factor;
+    range.max = median * options_.max_depth_factor;
+  }
+  return range;
 }
 
 // sigma = 1.4826 * MAD of the x and y residual components of the slot: the

@@ -1,8 +1,9 @@
 // The problem of the final bundle adjustment: one RigReprojectionCost per
 // observation (with a time model a TimedRigReprojectionCost, whose extra
-// blocks are the camera's offset and line delay) (a map image's: its cam_from_world as the "rig" pose, a
-// constant identity cam_from_rig), the blocks that are refined, held or
-// partly held, and its solve by the bundle solver (bundle_solver.h, the
+// blocks are the camera's offset and line delay and the frameset's
+// velocity, which has a prior) (a map image's: its cam_from_world as the
+// "rig" pose, a constant identity cam_from_rig), the blocks that are
+// refined, held or partly held, and its solve by the bundle solver (bundle_solver.h, the
 // options' backend) with the refined points eliminated.
 #include <glog/logging.h>
 
@@ -99,12 +100,13 @@ void RigAdjustment::AddResidualBlocks(
     colmap::Camera& camera = cameras_[image.camera_index];
     double* rig_from_world = rig_from_world_[image.frameset_index].data();
     double* cam_from_rig = cam_from_rig_[image.camera_index].data();
-    // Blocks: Q, P, theta[, delta, rho (time model)][, X].
+    // Blocks: Q, P, theta[, delta, rho, v (time model)][, X].
     std::vector<double*> blocks = {rig_from_world, cam_from_rig,
                                    camera.ParamsData()};
     if (options_.HasTimeModel()) {
       blocks.push_back(&time_offsets_[image.camera_index]);
       blocks.push_back(&line_delays_[image.camera_index]);
+      blocks.push_back(frameset_velocities_[image.frameset_index].data());
     }
     if (observation.refined_slot >= 0) {
       blocks.push_back(refined_points_[observation.refined_slot].data());
@@ -127,6 +129,13 @@ void RigAdjustment::AddResidualBlocks(
              identity_pose_.data(), camera.ParamsData(),
              RefinedPoint(MapObservationOf(observation).point3D_id)->data()}));
     has_fixed_points_ = has_fixed_points_ || !options_.refine_map;
+  }
+  if (options_.HasTimeModel() && options_.refine_rig_poses) {
+    std::vector<char> frameset_refined(rig_from_world_.size(), 0);
+    for (const Observation& observation : observations_) {
+      frameset_refined[dataset_.images[observation.image].frameset_index] = 1;
+    }
+    AddVelocityPriors(frameset_refined);
   }
 }
 
@@ -174,10 +183,16 @@ void RigAdjustment::AddParameterBlocks(
   }
   int group = 0;
   if (options_.refine_rig_poses) {
+    // With the time model a frameset's velocity is in its pose's group.
     for (size_t frameset = 0; frameset < rig_from_world_.size(); ++frameset) {
       if (!frameset_used[frameset]) continue;
       solver_->AddParameterBlock(rig_from_world_[frameset].data(), 7,
-                                 pose_manifold_.get(), group++);
+                                 pose_manifold_.get(), group);
+      if (options_.HasTimeModel()) {
+        solver_->AddParameterBlock(frameset_velocities_[frameset].data(), 3,
+                                   nullptr, group);
+      }
+      ++group;
     }
   }
   if (options_.refine_map) {

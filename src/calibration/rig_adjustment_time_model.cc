@@ -1,11 +1,12 @@
 // The final bundle adjustment's time model (final_bundle_adjuster.h): the
-// rig's motion around each frameset from the current rig poses, and the
-// estimated offsets and line delays.
+// rig's motion around each frameset from the current rig poses, the priors
+// of the estimated velocities, and the estimated offsets and line delays.
 #include <glog/logging.h>
 
 #include <algorithm>
 
 #include "src/calibration/rig_adjustment.h"
+#include "src/geometry/frameset_velocity_prior_cost.h"
 
 namespace rig_calibrator {
 
@@ -21,6 +22,32 @@ void RigAdjustment::UpdateFramesetMotions() {
                                &error))
       << error << " (checked by AdjustRig)";
   std::copy(motions.begin(), motions.end(), frameset_motions_.begin());
+  velocity_prior_sigma_ = FramesetVelocityPriorSigma(
+      motions,
+      velocities_started_ ? frameset_velocities_
+                          : std::vector<Eigen::Vector3d>(),
+      poses);
+  if (!velocities_started_) {
+    for (size_t f = 0; f < motions.size(); ++f) {
+      frameset_velocities_[f] =
+          Eigen::Map<const Eigen::Vector3d>(&motions[f][9]);
+    }
+    velocities_started_ = true;
+  }
+}
+
+void RigAdjustment::AddVelocityPriors(
+    const std::vector<char>& frameset_refined) {
+  for (size_t f = 0; f < frameset_refined.size(); ++f) {
+    if (!frameset_refined[f]) continue;
+    for (const int first_axis : {0, 2}) {
+      velocity_prior_costs_.push_back(
+          std::make_unique<FramesetVelocityPriorCost>(
+              &frameset_motions_[f], &velocity_prior_sigma_, first_axis));
+      solver_->AddResidualBlock(velocity_prior_costs_.back().get(), nullptr,
+                                {frameset_velocities_[f].data()});
+    }
+  }
 }
 
 std::vector<CameraCaptureTime> RigAdjustment::CaptureTimes() const {

@@ -88,4 +88,33 @@ bool ComputeFramesetMotions(
   return true;
 }
 
+void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,
+                           std::vector<FramesetMotion>* motions) {
+  if (velocities.size() != motions->size()) return;
+  for (size_t f = 0; f < motions->size(); ++f) {
+    for (int k = 0; k < 3; ++k) (*motions)[f][9 + k] = velocities[f](k);
+  }
+}
+
+double FramesetVelocityPriorSigma(
+    const std::vector<FramesetMotion>& motions,
+    const std::vector<Eigen::Vector3d>& velocities,
+    const std::vector<std::optional<Rigid3d>>& rig_from_world) {
+  double sum_speed = 0, sum_deviation = 0;
+  int count = 0;
+  for (size_t f = 0; f < motions.size() && f < rig_from_world.size(); ++f) {
+    if (!rig_from_world[f]) continue;
+    const Eigen::Map<const Eigen::Vector3d> p1(&motions[f][9]);
+    sum_speed += p1.squaredNorm();
+    if (velocities.size() == motions.size()) {
+      sum_deviation += (velocities[f] - p1).squaredNorm();
+    }
+    ++count;
+  }
+  const double speed = count > 0 ? std::sqrt(sum_speed / count) : 0.0;
+  if (!(speed > 0)) return 1.0;
+  if (velocities.size() != motions.size()) return speed;
+  return std::max(std::sqrt(sum_deviation / (3.0 * count)), 0.01 * speed);
+}
+
 }  // namespace rig_calibrator

@@ -29,7 +29,8 @@
 // model errs by tau^2/2 |u2|, 0.04 deg at tau = 50 ms and 0.5 rad/s^2, twice
 // the rotation accuracy the calibration reaches, and rolling-shutter rows
 // reach tau = 80 ms. Measured on the synthetic time model's trajectory
-// (frameset_motion_test.cc, FramesetMotion.ThirdOrderModelError...).
+// (capture_time_model_test.cc,
+// CaptureTimeModel.ThirdOrderMotionModelErrorOnTheSyntheticTrajectory).
 //
 // Derivatives. At each frameset with a pose, the degree <= 4 polynomial
 // through the (up to) five nearest posed framesets (the window shifted
@@ -39,6 +40,8 @@
 #pragma once
 
 #include <ceres/rotation.h>
+
+#include <Eigen/Core>
 
 #include <array>
 #include <optional>
@@ -63,12 +66,37 @@ bool ComputeFramesetMotions(const std::vector<double>& times_s,
                             std::vector<FramesetMotion>* motions,
                             std::string* error);
 
+// With the final adjustment's time model the rig's translational velocity
+// at each frameset is estimated, not taken from the polynomial: at a 5 Hz
+// frameset rate the polynomial through the frameset poses misses a walk's
+// bob (its p1 off by 0.25 m/s RMS on the synthetic walk at 1.5 m/s, 20 mm
+// at tau = 80 ms), while u1 and u2 stay within 0.001 rad/s and rad/s^2.
+// The estimate replaces p1 (`velocities`, per frameset, map units per
+// second in the rig frame at t_f; empty: none) where a frameset has a pose.
+void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,
+                           std::vector<FramesetMotion>* motions);
+
+// The scale of the estimated velocities' prior (per axis, map units per
+// second; frameset_velocity_prior_cost.h): over the framesets with a pose,
+// the RMS deviation of the velocities from the polynomial's p1 per axis,
+// sqrt(mean |v_f - p1_f|^2 / 3): an estimate of the polynomial's own error,
+// which is what the prior describes (updated between solves, an EM step for
+// the prior's variance: on the synthetic walk at 5 Hz it settles at 0.16
+// m/s per axis, the polynomial's 0.25 m/s RMS error); at least 1 % of the
+// RMS speed (|p1|), so that it never holds the images off. With
+// `velocities` empty (no estimate yet): the RMS speed. 1 for a rig at rest.
+double FramesetVelocityPriorSigma(
+    const std::vector<FramesetMotion>& motions,
+    const std::vector<Eigen::Vector3d>& velocities,
+    const std::vector<std::optional<Rigid3d>>& rig_from_world);
+
 // x_rig = Exp(-u(tau)) (Q_f X - p(tau)), with Q_f as [qw, qx, qy, qz, tx,
-// ty, tz] (PoseParams), for autodiff and for double.
+// ty, tz] (PoseParams) and p1 = `velocity` (3 values: the motion's own
+// &motion[9], or an estimated velocity), for autodiff and for double.
 template <typename T>
 void WorldToRigAtOffset(const T* rig_from_world, const T* point_in_world,
-                        const FramesetMotion& motion, const T& tau,
-                        T* point_in_rig) {
+                        const FramesetMotion& motion, const T* velocity,
+                        const T& tau, T* point_in_rig) {
   T at_frameset[3];
   ceres::QuaternionRotatePoint(rig_from_world, point_in_world, at_frameset);
   const T a1 = tau, a2 = tau * tau / 2.0, a3 = tau * tau * tau / 6.0;
@@ -76,7 +104,7 @@ void WorldToRigAtOffset(const T* rig_from_world, const T* point_in_world,
   for (int k = 0; k < 3; ++k) {
     minus_u[k] = -(a1 * motion[k] + a2 * motion[3 + k] + a3 * motion[6 + k]);
     at_frameset[k] += rig_from_world[4 + k] -
-                      (a1 * motion[9 + k] + a2 * motion[12 + k] +
+                      (a1 * velocity[k] + a2 * motion[12 + k] +
                        a3 * motion[15 + k]);
   }
   ceres::AngleAxisRotatePoint(minus_u, at_frameset, point_in_rig);

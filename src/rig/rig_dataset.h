@@ -114,6 +114,10 @@ struct RigCalibration {
   std::vector<colmap::Camera> map_cameras;
   std::vector<Rigid3d> map_cam_from_world;
   std::vector<std::vector<char>> map_observation_rejected;
+  // After a final bundle adjustment with a time model (else empty): per
+  // frameset the rig's estimated translational velocity at the frameset's
+  // time, in the rig frame there, map units per second (frameset_motion.h).
+  std::vector<Eigen::Vector3d> rig_velocities;
 
   Rigid3d CamFromWorld(int camera_index, int frameset_index) const {
     return cam_from_rig[camera_index] * *rig_from_world[frameset_index];

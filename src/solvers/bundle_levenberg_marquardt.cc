@@ -26,9 +26,9 @@ namespace {
 // sums over chunks (added in chunk order) do not depend on it.
 constexpr int kMaxNumChunks = 16;
 // A residual's blocks: a pose, a cam_from_rig, intrinsics, with the final
-// adjustment's time model a capture-time offset and a line delay, and a
-// point.
-constexpr int kMaxParametersPerResidual = 6;
+// adjustment's time model a capture-time offset, a line delay and the
+// frameset's velocity, and a point.
+constexpr int kMaxParametersPerResidual = 7;
 // Ceres' defaults (LevenbergMarquardtStrategy, TrustRegionMinimizer).
 constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;

@@ -166,25 +166,34 @@ TEST(FinalBundleAdjusterTest, FisheyeRigConverges) {
   ExpectExactSolution(rig, "fisheye", calibration, summary);
 }
 
-TEST(FinalBundleAdjusterTest, RejectsPointsBehindAndFarFromTheCamera) {
+// Behind the camera, farther than 50 times the median depth, and on the
+// ray of its observation but 10^-6 from the camera centre (it projects
+// exactly, and its Jacobian is 10^12 times the others': a point collapsed
+// onto a camera, as on EuRoC's map): all three rejected.
+TEST(FinalBundleAdjusterTest, RejectsPointsBehindTooNearAndFarFromTheCamera) {
   SyntheticBaScene rig = MakeSyntheticRig(SceneOptions());
   RigImage& image = rig.dataset.images[0];
-  const Rigid3d world_from_cam =
-      rig.truth.CamFromWorld(image.camera_index, image.frameset_index)
-          .Inverse();
+  const Rigid3d cam_from_world =
+      rig.truth.CamFromWorld(image.camera_index, image.frameset_index);
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
   Correspondence behind = image.correspondences[0];
   behind.point3D = world_from_cam * Eigen::Vector3d(0.1, 0.2, -5);
   Correspondence far = image.correspondences[1];
   far.point3D = world_from_cam * Eigen::Vector3d(1000, 0, 5000);
+  Correspondence near = image.correspondences[2];
+  const Eigen::Vector3d in_cam = cam_from_world * near.point3D;
+  near.point3D = world_from_cam * (in_cam * (1e-6 / in_cam.z()));
   image.correspondences.push_back(behind);
   image.correspondences.push_back(far);
+  image.correspondences.push_back(near);
   rig.truth.images[0].inlier_mask.assign(image.correspondences.size(), 1);
   RigCalibration calibration = PerturbedStart(rig, 8);
   FinalBundleAdjustmentSummary summary;
   ASSERT_TRUE(AdjustRig(FinalBundleAdjustmentOptions(), rig.dataset,
                         &calibration, &summary));
-  EXPECT_EQ(summary.num_outliers, 2);
+  EXPECT_EQ(summary.num_outliers, 3);
   const std::vector<char>& mask = calibration.images[0].inlier_mask;
+  EXPECT_FALSE(mask[mask.size() - 3]);
   EXPECT_FALSE(mask[mask.size() - 2]);
   EXPECT_FALSE(mask[mask.size() - 1]);
   EXPECT_TRUE(std::isfinite(summary.final_rms_px));
