@@ -16,8 +16,11 @@
 #   2. the rig and intrinsics as accurate as the synchronized run's: the
 #      worst camera's rotation, centre, focal length and principal point
 #      errors (colmap rig_calibrator evaluate) within 1.25 times the
-#      synchronized run's, or within 0.005 deg, 0.5 mm, 0.01 % and
-#      0.05 px of it (the ratios of errors that small are noise);
+#      synchronized run's, or within the larger of 0.005 deg, 0.5 mm,
+#      0.01 % and 0.05 px and the time model's own 1-sigma (its worst
+#      camera's, from the summary) of it: one run's error spreads by its
+#      sigma, and the COLMAP map differs from run to run (the synchronized
+#      rotation error was 0.013 deg in one run, 0.020 deg in another);
 #   3. the outputs agree with the summary (check_calibration_outputs).
 #
 # Usage: tests/e2e/gopro_helmet_e2e.sh BUILD_DIR [WORK_DIR]
@@ -85,21 +88,43 @@ for run in demo synchronized; do
     --calibration_path "$folder/rig/calibration" --output_path "$work/errors_$run.json" \
     > "$work/evaluate_$run.log" || fail "evaluate ($run)"
 done
-/usr/bin/python3 - "$work/errors_demo.json" "$work/errors_synchronized.json" << 'PYTHON' || fail "the time model's rig is less accurate than 1.25 times the synchronized one's"
-import json, sys
+/usr/bin/python3 - "$work/errors_demo.json" "$work/errors_synchronized.json" \
+  "$demo/rig/calibration/calibration_summary.json" << 'PYTHON' || fail "the time model's rig is less accurate than 1.25 times the synchronized one's"
+import json, math, sys
 timed, synchronized = (json.load(open(path))["cameras"] for path in sys.argv[1:3])
+
+# The time model's worst 1-sigma per quantity over its cameras.
+def sigmas(camera):
+    u, params = camera["uncertainty"], camera["params"]
+    single_focal = camera["model"].startswith("SIMPLE_") or camera["model"] in (
+        "RADIAL", "RADIAL_FISHEYE")
+    c = 1 if single_focal else 2
+    return {"rotation_deg": u["rotation_stddev_deg"],
+            "center_error": math.hypot(*u["center_in_rig_stddev"]),
+            "focal_error_percent": 100 * u["params_stddev"][0] / params[0],
+            "principal_point_error_px": math.hypot(u["params_stddev"][c],
+                                                   u["params_stddev"][c + 1])}
+summary_cameras = json.load(open(sys.argv[3]))["cameras"]
+worst_sigma = {}
+for camera in summary_cameras:
+    if not camera.get("uncertainty", {}).get("determined"):
+        continue
+    for key, value in sigmas(camera).items():
+        worst_sigma[key] = max(worst_sigma.get(key, 0.0), value)
 failed = False
 for key, floor, unit in (("rotation_deg", 0.005, "deg"), ("center_error", 0.0005, "m"),
                          ("focal_error_percent", 0.01, "%"),
                          ("principal_point_error_px", 0.05, "px")):
     worst_timed = max(camera[key] for camera in timed)
     worst_synchronized = max(camera[key] for camera in synchronized)
-    bound = max(1.25 * worst_synchronized, worst_synchronized + floor)
+    margin = max(floor, worst_sigma.get(key, 0.0))
+    bound = max(1.25 * worst_synchronized, worst_synchronized + margin)
     ok = worst_timed <= bound
     failed |= not ok
     print(f"[gopro_e2e] {key}: time model {worst_timed:.4g} {unit}, synchronized "
           f"{worst_synchronized:.4g} {unit} (ratio {worst_timed / worst_synchronized:.2f}, "
-          f"bound {bound:.4g}){'' if ok else ' FAILED'}")
+          f"the time model's sigma {worst_sigma.get(key, 0.0):.4g}, bound {bound:.4g})"
+          f"{'' if ok else ' FAILED'}")
 sys.exit(1 if failed else 0)
 PYTHON
 
