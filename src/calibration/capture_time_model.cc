@@ -410,4 +410,15 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
   return true;
 }
 
+std::vector<FramesetMotion> AdjustedFramesetMotions(
+    const RigDataset& dataset, const RigCalibration& calibration) {
+  std::vector<FramesetMotion> motions;
+  std::string error;
+  CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
+                               calibration.rig_from_world, &motions, &error))
+      << error << " (the capture-time model ran on these poses)";
+  UseFramesetVelocities(calibration.rig_velocities, &motions);
+  return motions;
+}
+
 }  // namespace rig_calibrator

@@ -65,6 +65,7 @@
 #include "src/calibration/capture_timing.h"
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/time_offsets_from_rotations.h"
+#include "src/geometry/frameset_motion.h"
 
 namespace rig_calibrator {
 
@@ -137,6 +138,14 @@ FinalBundleAdjustmentOptions WithCaptureTimes(
 // computed).
 void SetCaptureTimeSigmas(const CalibrationUncertainty& uncertainty,
                           std::vector<CameraCaptureTime>* times);
+
+// The rig's motion at every frameset as the time-model adjustment has it
+// (frameset_motion.h): the polynomial through the calibration's frameset
+// poses, its velocity the estimated one (RigCalibration::rig_velocities;
+// the polynomial's while there is none). For poses the time model runs on
+// (CHECK-fails when the motions cannot be computed, which those exclude).
+std::vector<FramesetMotion> AdjustedFramesetMotions(
+    const RigDataset& dataset, const RigCalibration& calibration);
 
 // The step above. `calibration` is today's final-adjustment result; it is
 // replaced by the time-model result when a kind is kept. `ba_options` the

@@ -1,10 +1,8 @@
 #include "src/calibration/inlier_selection.h"
 
-#include <glog/logging.h>
-
-#include <string>
 #include <unordered_map>
 
+#include "src/calibration/capture_time_model.h"
 #include "src/geometry/frameset_motion.h"
 #include "src/geometry/radial_error.h"
 #include "src/geometry/timed_rig_reprojection_cost.h"
@@ -66,11 +64,7 @@ void SelectFullInliers(const RigDataset& dataset, double max_error_px,
   const bool timed = !time_offsets_s.empty() || !line_delays_s.empty();
   std::vector<FramesetMotion> motions;
   if (timed) {
-    std::string error;
-    CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
-                                 calibration->rig_from_world, &motions, &error))
-        << error;
-    UseFramesetVelocities(calibration->rig_velocities, &motions);
+    motions = AdjustedFramesetMotions(dataset, *calibration);
   }
   const auto at = [](const std::vector<double>& values, int camera) {
     return values.empty() ? 0.0 : values[camera];

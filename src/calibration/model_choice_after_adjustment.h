@@ -1,9 +1,11 @@
 // The camera model chosen again on the adjusted rig: the first choice
 // (model_selection.h) is made at the camera upgrade, on residuals of 2-4 px
 // of poses that are not yet adjusted, where a flexible model absorbs the
-// poses' errors; after the final bundle adjustment the rig poses and the
-// points are what the whole rig and the map say, and the candidates are
-// compared on them.
+// poses' errors; after the final bundle adjustment the rig poses are what
+// the whole rig and the map say, and the candidates are compared on them
+// and on the points as the other images place them (refined points:
+// points_without_camera.h; a refined point keeps the current model's
+// error where the camera's own rays dominate it).
 //
 // Per candidate model, the camera's own parameters are fitted to its final
 // inliers with every frameset's rig_from_world and every point held:

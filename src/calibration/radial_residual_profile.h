@@ -46,6 +46,11 @@
 // (|mean| - floor) / SE beyond the threshold.
 #pragma once
 
+// First: COLMAP's std::vector<Eigen::Vector2d> specialization (its aligned
+// allocator) must precede any use of that vector type, here and in the
+// files that include this header.
+#include <colmap/util/types.h>
+
 #include <Eigen/Core>
 #include <string>
 #include <vector>

@@ -56,8 +56,8 @@ size_t RigAdjustment::RejectOutliers(bool prune_residuals) {
 size_t RigAdjustment::RejectMapOutliers() {
   const std::vector<MapObservationRef> map_observations =
       MapObservationsOfRefinedPoints();
-  // The rig observations too, for the depth range; their thresholds are
-  // those of RejectOutliers' last call.
+  // The rig observations too, for the depth range only (the rig
+  // observations' thresholds computed with it are not used here).
   const SlotErrors errors =
       EvaluateWithSlots(/*with_rig_observations=*/true, map_observations);
   const DepthRange depth_range = DepthRangeOf(errors);

@@ -72,7 +72,8 @@ bool ComputeFramesetMotions(const std::vector<double>& times_s,
 // bob (its p1 off by 0.25 m/s RMS on the synthetic walk at 1.5 m/s, 20 mm
 // at tau = 80 ms), while u1 and u2 stay within 0.001 rad/s and rad/s^2.
 // The estimate replaces p1 (`velocities`, per frameset, map units per
-// second in the rig frame at t_f; empty: none) where a frameset has a pose.
+// second in the rig frame at t_f; empty: none) for every frameset (one
+// without a pose has zero motion, and its velocity stays zero).
 void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,
                            std::vector<FramesetMotion>* motions);
 
