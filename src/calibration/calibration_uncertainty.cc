@@ -45,10 +45,10 @@ constexpr int kMinNumClusters = 3;
 // beyond any determined calibration (sigma ratio 1e5) and far above the
 // rounding of a sum of a million products (1e-16 * 1e6).
 constexpr double kMinScaledEigenvalue = 1e-10;
-// At most this many map images whose poses the data do not determine are
-// left out before the uncertainty is given up
+// At most this many map images and framesets whose poses the data do not
+// determine are left out before the uncertainty is given up
 // (EstimateCalibrationUncertainty).
-constexpr int kMaxHeldMapImages = 20;
+constexpr int kMaxLeftOutPoses = 20;
 // A pixel whose unprojection does not project back within this distance is
 // where the estimated model is not invertible: no projection uncertainty.
 constexpr double kMaxRoundTripErrorPx = 0.01;
@@ -177,21 +177,25 @@ double Median(std::vector<double> values) {
 // The reduced problem of one calibration and its solution.
 class UncertaintyProblem {
  public:
-  // held_map_images: per map image, left out (see
+  // left_out_map_images, left_out_framesets: per map image and per
+  // frameset, left out with its observations (see
   // EstimateCalibrationUncertainty); empty: none.
   UncertaintyProblem(const FinalBundleAdjustmentOptions& ba_options,
                      const RigDataset& dataset,
                      const RigCalibration& calibration,
-                     const std::vector<char>& held_map_images)
+                     const std::vector<char>& left_out_map_images,
+                     const std::vector<char>& left_out_framesets)
       : options_(ba_options),
         dataset_(dataset),
         calibration_(calibration),
-        held_map_images_(held_map_images) {}
+        left_out_map_images_(left_out_map_images),
+        left_out_framesets_(left_out_framesets) {}
 
   bool Run(const UncertaintyOptions& options, CalibrationUncertainty* result);
-  // After a Run that failed on a singular reduced system: the map image
-  // whose pose held the smallest pivot, -1 when it was not a map pose.
+  // After a Run that failed on a singular reduced system: the map image or
+  // the frameset whose pose held the smallest pivot, -1 when it was not.
   int undetermined_map_image() const { return undetermined_map_image_; }
+  int undetermined_frameset() const { return undetermined_frameset_; }
 
  private:
   bool SetUpTimeModel(std::string* error);
@@ -219,8 +223,8 @@ class UncertaintyProblem {
   const RigCalibration& calibration_;
 
   std::vector<PoseArray> rig_from_world_, cam_from_rig_, map_cam_from_world_;
-  std::vector<char> held_map_images_;
-  int undetermined_map_image_ = -1;
+  std::vector<char> left_out_map_images_, left_out_framesets_;
+  int undetermined_map_image_ = -1, undetermined_frameset_ = -1;
   PoseArray identity_ = {1, 0, 0, 0, 0, 0, 0};
   std::vector<std::vector<int>> free_intrinsics_;  // per rig camera
   std::vector<std::vector<int>> map_free_intrinsics_;
@@ -315,7 +319,8 @@ bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
   line_delays_ = values(options_.initial_line_delays_s);
   if (!ComputeFramesetMotions(dataset_.frameset_times_s,
                               calibration_.rig_from_world, &frameset_motions_,
-                              error)) {
+                              error,
+                              calibration_.frameset_motions_without_own_pose)) {
     *error = "the time model's frameset motions: " + *error;
     return false;
   }
@@ -359,7 +364,10 @@ void UncertaintyProblem::CollectObservations() {
     const RigImage& image = dataset_.images[i];
     const int c = image.camera_index;
     if (!calibration_.camera_calibrated[c] ||
-        !calibration_.rig_from_world[image.frameset_index]) {
+        !calibration_.rig_from_world[image.frameset_index] ||
+        (static_cast<size_t>(image.frameset_index) <
+             left_out_framesets_.size() &&
+         left_out_framesets_[image.frameset_index])) {
       continue;
     }
     const std::vector<char>& mask = calibration_.images[i].inlier_mask;
@@ -416,7 +424,7 @@ void UncertaintyProblem::CollectObservations() {
       map_params_.push_back(camera.Params());
     }
     for (size_t m = 0; m < dataset_.map_images.size(); ++m) {
-      if (m < held_map_images_.size() && held_map_images_[m]) continue;
+      if (m < left_out_map_images_.size() && left_out_map_images_[m]) continue;
       const MapImage& image = dataset_.map_images[m];
       for (size_t k = 0; k < image.observations.size(); ++k) {
         const MapObservation& map_observation = image.observations[k];
@@ -801,13 +809,18 @@ bool UncertaintyProblem::Marginalize(CalibrationUncertainty* result) {
           result->message += " (first undetermined: " +
                              DescribeNuisanceParameter(static_cast<int>(i)) +
                              ")";
-          for (size_t m = 0; m < map_pose_block_.size(); ++m) {
-            const int block = map_pose_block_[m];
-            if (block >= 0 && i >= blocks_[block].offset &&
-                i < blocks_[block].offset + blocks_[block].dim) {
-              undetermined_map_image_ = static_cast<int>(m);
+          const auto owner = [&](const std::vector<int>& slot) {
+            for (size_t k = 0; k < slot.size(); ++k) {
+              const int block = slot[k];
+              if (block >= 0 && i >= blocks_[block].offset &&
+                  i < blocks_[block].offset + blocks_[block].dim) {
+                return static_cast<int>(k);
+              }
             }
-          }
+            return -1;
+          };
+          undetermined_map_image_ = owner(map_pose_block_);
+          undetermined_frameset_ = owner(rig_pose_block_);
           break;
         }
       }
@@ -1326,26 +1339,51 @@ CalibrationUncertainty EstimateCalibrationUncertainty(
     // system singular: the image is left out and the uncertainty computed
     // again. Left out, not held: a held pose with its observations would pin
     // the free world (the map's gauge) to its few points. On the real EuRoC
-    // pair one such map image left the uncertainty uncomputed.
-    std::vector<char> held(dataset.map_images.size(), 0);
-    std::vector<std::string> held_names;
-    for (int attempt = 0; attempt <= kMaxHeldMapImages; ++attempt) {
+    // pair one such map image left the uncertainty uncomputed. So is a
+    // frameset whose observations do not determine its rig pose (a few
+    // inliers, as at the end of a fast turn where the synchronized fit kept
+    // 3 of a 15 Hz helmet frameset's correspondences); the calibration
+    // loses only that frameset's few observations.
+    std::vector<char> left_out_map_images(dataset.map_images.size(), 0);
+    std::vector<char> left_out_framesets(dataset.frameset_names.size(), 0);
+    std::vector<std::string> map_image_names, frameset_names;
+    for (int attempt = 0; attempt <= kMaxLeftOutPoses; ++attempt) {
       result = CalibrationUncertainty();
-      UncertaintyProblem problem(ba_options, dataset, calibration, held);
+      UncertaintyProblem problem(ba_options, dataset, calibration,
+                                 left_out_map_images, left_out_framesets);
       result.computed = problem.Run(options, &result);
+      if (result.computed) break;
       const int map_image = problem.undetermined_map_image();
-      if (result.computed || map_image < 0 || held[map_image]) break;
-      held[map_image] = 1;
-      held_names.push_back(dataset.map_images[map_image].name);
-    }
-    if (result.computed && !held_names.empty()) {
-      std::string names;
-      for (const std::string& name : held_names) {
-        names += (names.empty() ? "" : ", ") + name;
+      const int frameset = problem.undetermined_frameset();
+      if (map_image >= 0 && !left_out_map_images[map_image]) {
+        left_out_map_images[map_image] = 1;
+        map_image_names.push_back(dataset.map_images[map_image].name);
+      } else if (frameset >= 0 && !left_out_framesets[frameset]) {
+        left_out_framesets[frameset] = 1;
+        frameset_names.push_back(dataset.frameset_names[frameset]);
+      } else {
+        break;
       }
-      result.method += "; the poses of " + std::to_string(held_names.size()) +
+    }
+    const auto list = [](const std::vector<std::string>& names) {
+      std::string text;
+      for (const std::string& name : names) {
+        text += (text.empty() ? "" : ", ") + name;
+      }
+      return text;
+    };
+    if (result.computed && !map_image_names.empty()) {
+      result.method += "; the poses of " +
+                       std::to_string(map_image_names.size()) +
                        " map image(s) that the data do not determine left "
-                       "out (" + names + ")";
+                       "out (" + list(map_image_names) + ")";
+    }
+    if (result.computed && !frameset_names.empty()) {
+      result.method += "; the rig poses of " +
+                       std::to_string(frameset_names.size()) +
+                       " frameset(s) that the data do not determine left "
+                       "out with their observations (" +
+                       list(frameset_names) + ")";
     }
   }
   if (!result.computed) result.cameras.clear();

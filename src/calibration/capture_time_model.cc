@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <limits>
 #include <sstream>
 
 #include "src/calibration/calibration_uncertainty.h"
@@ -415,7 +414,8 @@ std::vector<FramesetMotion> AdjustedFramesetMotions(
   std::vector<FramesetMotion> motions;
   std::string error;
   CHECK(ComputeFramesetMotions(dataset.frameset_times_s,
-                               calibration.rig_from_world, &motions, &error))
+                               calibration.rig_from_world, &motions, &error,
+                               calibration.frameset_motions_without_own_pose))
       << error << " (the capture-time model ran on these poses)";
   UseFramesetVelocities(calibration.rig_velocities, &motions);
   return motions;

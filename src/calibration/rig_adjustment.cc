@@ -382,6 +382,7 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
     }
   }
   calibration->rig_velocities = frameset_velocities_;
+  calibration->frameset_motions_without_own_pose = frameset_without_own_pose_;
   for (size_t i = 0; i < dataset_.images.size(); ++i) {
     ImageResult& result = calibration->images[i];
     result.inlier_mask.assign(dataset_.images[i].correspondences.size(), 0);

@@ -183,11 +183,13 @@ class RigAdjustment {
   std::vector<bool> has_rig_pose_;
   // The time model (empty without): per camera its offset and line delay,
   // per frameset its motion from the poses (sized once: the costs point
-  // into it) and its estimated translational velocity, which replaces the
-  // motion's p1 (frameset_motion.h); the velocities' prior scale and costs.
+  // into it), whether that motion leaves the frameset's own pose out, and
+  // its estimated translational velocity, which replaces the motion's p1
+  // (frameset_motion.h); the velocities' prior scale and costs.
   std::vector<double> time_offsets_;
   std::vector<double> line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
+  std::vector<char> frameset_without_own_pose_;
   std::vector<Eigen::Vector3d> frameset_velocities_;
   bool velocities_started_ = false;
   double velocity_prior_sigma_ = 1;

@@ -15,11 +15,19 @@ namespace rig_calibrator {
 
 bool RigAdjustment::Solve(double function_tolerance,
                           BundleSolverSummary* summary) {
+  if (options_.HasTimeModel()) {
+    // The motion at the current rig poses, held during the solve. An
+    // observation that it puts behind its camera (or out of the depth
+    // range) leaves: the solve cannot start from a residual it cannot
+    // evaluate (a wide fisheye's point near 90 degrees off axis, when the
+    // motion over 40 ms changed with the poses; on a 15 Hz car this failed
+    // the time model's whole adjustment).
+    UpdateFramesetMotions();
+    RejectOutliers(/*prune_residuals=*/false);
+  }
   if (options_.refine_points && !selection_current_) {
     SelectRefinedPoints();
   }
-  // The motion at the current rig poses, held during the solve.
-  if (options_.HasTimeModel()) UpdateFramesetMotions();
   if (solver_ == nullptr) {
     BundleSolverOptions solver_options;
     solver_options.max_num_iterations = options_.max_num_iterations;

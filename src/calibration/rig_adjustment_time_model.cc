@@ -7,19 +7,34 @@
 
 #include "src/calibration/rig_adjustment.h"
 #include "src/geometry/frameset_velocity_prior_cost.h"
+#include "src/geometry/timed_rig_reprojection_cost.h"
 
 namespace rig_calibrator {
 
+// The frameset motions from the current poses; where the alternation
+// between the motions and the poses would grow the poses' errors at the
+// images' instants (the current offsets, line delays at the middle row), a
+// frameset's motion leaves its own pose out (FramesetsWithoutOwnPose,
+// frameset_motion.h).
 void RigAdjustment::UpdateFramesetMotions() {
   std::vector<std::optional<Rigid3d>> poses(rig_from_world_.size());
   for (size_t f = 0; f < rig_from_world_.size(); ++f) {
     if (has_rig_pose_[f]) poses[f] = FromPoseParams(rig_from_world_[f]);
   }
+  std::vector<std::vector<double>> capture_offsets(rig_from_world_.size());
+  for (const RigImage& image : dataset_.images) {
+    const int c = image.camera_index;
+    capture_offsets[image.frameset_index].push_back(CaptureTimeOfRow(
+        time_offsets_[c], line_delays_[c],
+        dataset_.cameras[c].camera.Height() / 2.0));
+  }
+  frameset_without_own_pose_ = FramesetsWithoutOwnPose(
+      dataset_.frameset_times_s, poses, capture_offsets);
   // Written in place: the costs point into frameset_motions_.
   std::vector<FramesetMotion> motions;
   std::string error;
   CHECK(ComputeFramesetMotions(dataset_.frameset_times_s, poses, &motions,
-                               &error))
+                               &error, frameset_without_own_pose_))
       << error << " (checked by AdjustRig)";
   std::copy(motions.begin(), motions.end(), frameset_motions_.begin());
   velocity_prior_sigma_ = FramesetVelocityPriorSigma(

@@ -9,18 +9,18 @@
 namespace rig_calibrator {
 namespace {
 
-// Weights w_k[j] such that the k-th derivative at nodes[center] of the
+// Weights w_k[j] such that the k-th derivative at time `at` of the
 // interpolating polynomial through (nodes[j], y_j) is sum_j w_k[j] y_j,
 // k = 1..3 (zero rows above the polynomial's degree). From the Vandermonde
-// system in s = (t - nodes[center]) / scale, scale the nodes' span, so that
-// it stays well conditioned.
+// system in s = (t - at) / scale, scale the nodes' span, so that it stays
+// well conditioned.
 Eigen::Matrix<double, 3, Eigen::Dynamic> DerivativeWeights(
-    const std::vector<double>& nodes, int center) {
+    const std::vector<double>& nodes, double at) {
   const int n = static_cast<int>(nodes.size());
   const double scale = nodes.back() - nodes.front();
   Eigen::MatrixXd vandermonde(n, n);
   for (int j = 0; j < n; ++j) {
-    const double s = (nodes[j] - nodes[center]) / scale;
+    const double s = (nodes[j] - at) / scale;
     for (int m = 0; m < n; ++m) vandermonde(j, m) = std::pow(s, m);
   }
   // Row m of V^-1 maps the values to the coefficient of s^m; the k-th
@@ -36,43 +36,74 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> DerivativeWeights(
   return weights;
 }
 
+// The posed framesets (indices into the frameset list).
+std::vector<int> PosedFramesets(
+    const std::vector<std::optional<Rigid3d>>& rig_from_world) {
+  std::vector<int> posed;
+  for (size_t f = 0; f < rig_from_world.size(); ++f) {
+    if (rig_from_world[f]) posed.push_back(static_cast<int>(f));
+  }
+  return posed;
+}
+
+constexpr int kStencil = 5;
+
+// The knots of posed frameset posed[i]'s polynomial (see the header): the
+// window of the kStencil nearest posed framesets, without posed[i] itself
+// when `without_own_pose` and at least two others remain.
+std::vector<int> Knots(const std::vector<int>& posed, int i,
+                       bool without_own_pose) {
+  const int n = static_cast<int>(posed.size());
+  const int stencil = std::min(n, kStencil);
+  const int first = std::clamp(i - stencil / 2, 0, n - stencil);
+  std::vector<int> knots;
+  for (int j = first; j < first + stencil; ++j) {
+    if (j != i || !without_own_pose || stencil < 3) knots.push_back(posed[j]);
+  }
+  return knots;
+}
+
 }  // namespace
 
 bool ComputeFramesetMotions(
     const std::vector<double>& times_s,
     const std::vector<std::optional<Rigid3d>>& rig_from_world,
-    std::vector<FramesetMotion>* motions, std::string* error) {
+    std::vector<FramesetMotion>* motions, std::string* error,
+    const std::vector<char>& without_own_pose) {
   if (times_s.size() != rig_from_world.size()) {
     *error = "frameset motion: " + std::to_string(times_s.size()) +
              " frameset times for " + std::to_string(rig_from_world.size()) +
              " framesets";
     return false;
   }
-  std::vector<int> posed;
-  for (size_t f = 0; f < rig_from_world.size(); ++f) {
-    if (rig_from_world[f]) posed.push_back(static_cast<int>(f));
+  if (!without_own_pose.empty() &&
+      without_own_pose.size() != rig_from_world.size()) {
+    *error = "frameset motion: " + std::to_string(without_own_pose.size()) +
+             " own-pose flags for " + std::to_string(rig_from_world.size()) +
+             " framesets";
+    return false;
   }
+  const std::vector<int> posed = PosedFramesets(rig_from_world);
   if (posed.size() < 2) {
     *error = "frameset motion: fewer than two framesets have a rig pose";
     return false;
   }
-  const int n = static_cast<int>(posed.size());
-  const int stencil = std::min(n, 5);
   motions->assign(times_s.size(), FramesetMotion{});
-  for (int i = 0; i < n; ++i) {
-    const int first = std::clamp(i - stencil / 2, 0, n - stencil);
-    const Rigid3d world_from_rig = rig_from_world[posed[i]]->Inverse();
+  for (size_t i = 0; i < posed.size(); ++i) {
+    const int frameset = posed[i];
+    const std::vector<int> knots =
+        Knots(posed, static_cast<int>(i),
+              !without_own_pose.empty() && without_own_pose[frameset]);
+    const Rigid3d world_from_rig = rig_from_world[frameset]->Inverse();
     const Eigen::Matrix3d rotation_t =
         world_from_rig.RotationMatrix().transpose();
     std::vector<double> nodes;
-    for (int j = first; j < first + stencil; ++j) {
-      nodes.push_back(times_s[posed[j]]);
-    }
+    for (const int knot : knots) nodes.push_back(times_s[knot]);
     const Eigen::Matrix<double, 3, Eigen::Dynamic> weights =
-        DerivativeWeights(nodes, i - first);
-    FramesetMotion& motion = (*motions)[posed[i]];
-    for (int j = 0; j < stencil; ++j) {
-      const Rigid3d knot = rig_from_world[posed[first + j]]->Inverse();
+        DerivativeWeights(nodes, times_s[frameset]);
+    FramesetMotion& motion = (*motions)[frameset];
+    for (size_t j = 0; j < knots.size(); ++j) {
+      const Rigid3d knot = rig_from_world[knots[j]]->Inverse();
       const Eigen::Vector3d u =
           LogSO3(rotation_t * knot.RotationMatrix());
       const Eigen::Vector3d p =
@@ -86,6 +117,64 @@ bool ComputeFramesetMotions(
     }
   }
   return true;
+}
+
+std::vector<char> FramesetsWithoutOwnPose(
+    const std::vector<double>& times_s,
+    const std::vector<std::optional<Rigid3d>>& rig_from_world,
+    const std::vector<std::vector<double>>& capture_offsets_s) {
+  std::vector<char> without(rig_from_world.size(), 0);
+  const std::vector<int> posed = PosedFramesets(rig_from_world);
+  if (times_s.size() != rig_from_world.size() ||
+      capture_offsets_s.size() != rig_from_world.size() || posed.size() < 3) {
+    return without;
+  }
+  // The alternating pattern's gain, 8/3 mean (tau / Delta)^2 over every
+  // image (Delta the median interval between posed framesets).
+  std::vector<double> intervals;
+  for (size_t i = 1; i < posed.size(); ++i) {
+    intervals.push_back(times_s[posed[i]] - times_s[posed[i - 1]]);
+  }
+  std::nth_element(intervals.begin(),
+                   intervals.begin() + intervals.size() / 2, intervals.end());
+  const double interval = intervals[intervals.size() / 2];
+  double sum_squares = 0;
+  int count = 0;
+  for (const int frameset : posed) {
+    for (const double tau : capture_offsets_s[frameset]) {
+      sum_squares += (tau / interval) * (tau / interval);
+      ++count;
+    }
+  }
+  const bool alternating_unstable =
+      count > 0 && interval > 0 &&
+      8.0 / 3.0 * sum_squares / count > kMaxOwnPoseGain;
+  for (size_t i = 0; i < posed.size(); ++i) {
+    const int frameset = posed[i];
+    const std::vector<double>& offsets = capture_offsets_s[frameset];
+    const std::vector<int> knots = Knots(posed, static_cast<int>(i), false);
+    // The alternating pattern's gain above is that of a window centred on
+    // the frameset; the ends keep their own pose unless its own gain says.
+    if (alternating_unstable && knots[knots.size() / 2] == frameset) {
+      without[frameset] = 1;
+      continue;
+    }
+    if (offsets.empty()) continue;
+    std::vector<double> nodes;
+    int own = 0;
+    for (size_t j = 0; j < knots.size(); ++j) {
+      nodes.push_back(times_s[knots[j]]);
+      if (knots[j] == frameset) own = static_cast<int>(j);
+    }
+    const Eigen::Vector3d w =
+        DerivativeWeights(nodes, times_s[frameset]).col(own);
+    double gain = 0;
+    for (const double tau : offsets) {
+      gain += w(0) * tau + w(1) * tau * tau / 2 + w(2) * tau * tau * tau / 6;
+    }
+    without[frameset] = std::abs(gain / offsets.size()) > kMaxOwnPoseGain;
+  }
+  return without;
 }
 
 void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,

@@ -37,6 +37,45 @@
 // inward at the ends; fewer knots lower the degree) of u_j = Log(R_f^T R_j)
 // and p_j = R_f^T (c_j - c_f), differentiated at t_f. Its error is O(Delta^5
 // / Delta^k) for the k-th derivative, Delta the frameset interval.
+//
+// The frameset's own pose in that polynomial. The motion is held within a
+// solve and recomputed from the adjusted poses between solves, and through
+// the poses it feeds back: a change e_j of pose j moves frameset f's k-th
+// derivative by w_kj e_j, so an image taken tau after t_f sees the rig moved
+// by sum_j G_j(tau) e_j, G_j(tau) = sum_k w_kj tau^k / k!, on top of its own
+// pose's change (w_kf taken with the own pose's sign: u_f = p_f = 0 there).
+// The next solve undoes it by moving the poses the other way, and the
+// alternation multiplies the poses' error by about the mean G over the
+// images, which must stay well below 1. Two patterns are the worst:
+//  - the own pose alone at the last frameset of the quartic through five
+//    (w = 25/12 / Delta, 35/12 / Delta^2, 5/2 / Delta^3 for Delta the
+//    interval): at 15 Hz 1.5 for a helmet frameset whose images are up to
+//    53 ms late and without its reference camera's image; the pose ran
+//    1.6 m off in two solves, took the offsets 1 ms off and left the
+//    uncertainty undetermined;
+//  - poses alternating from frameset to frameset, in the interior: the
+//    second derivative's weights (-1/12, 4/3, -5/2, 4/3, -1/12) / Delta^2
+//    add up to -16/3 / Delta^2 on it, G = -8/3 (tau / Delta)^2: at 15 Hz
+//    -0.73 over a car's images (offsets in +-36 ms, 22 us/row), whose
+//    offsets ended 2.6 ms off.
+// Through the window's other framesets alone (the polynomial of degree <= 3
+// through four), a change dc of the own position shifts every knot alike
+// (p_j by -R_f^T dc) and moves no derivative, a change of its rotation only
+// re-expresses the motion in the turned frame (by about |u(tau)| and
+// |p(tau)| times it: centimetres against the metres to the points), and
+// the alternating pattern's gain is +2/3 (tau / Delta)^2. So the interior
+// framesets' motions (a window centred on the frameset) leave their own
+// pose out where the alternating gain's mean over all images (the median
+// interval) exceeds kMaxOwnPoseGain, and any frameset's does where its own
+// gain's mean over its images does. Without the own pose the motion is
+// less accurate, at the ends most (an extrapolation there: 0.005 deg and
+// 23 mm at |tau| <= 80 ms on the synthetic walk at 15 Hz, against 0.0004
+// deg and 2 mm; and the velocities' prior, whose width their deviations
+// from p1 set, widens with it), so it is not the rule: at 5 Hz and +-50 ms
+// every frameset keeps its own pose (leaving it out at the two ends took
+// the ring's centre from 0.56 to 3.7 mm); at 15 Hz and +-50 ms the interior
+// ones leave it out, and an end does where its images are late (or early)
+// on average.
 #pragma once
 
 #include <ceres/rotation.h>
@@ -58,13 +97,34 @@ using FramesetMotion = std::array<double, 18>;
 // Per frameset the motion above from the rig poses of the framesets that
 // have one (rig_from_world, one entry per frameset) at `times_s` (one per
 // frameset, strictly increasing); zero motion for framesets without a pose.
-// False with `error` when sizes differ or fewer than two framesets have a
-// pose.
+// `without_own_pose` (per frameset, or empty: none) marks the framesets
+// whose motion leaves their own pose out (see above; with fewer than three
+// posed framesets it is kept). False with `error` when sizes differ or
+// fewer than two framesets have a pose.
 bool ComputeFramesetMotions(const std::vector<double>& times_s,
                             const std::vector<std::optional<Rigid3d>>&
                                 rig_from_world,
                             std::vector<FramesetMotion>* motions,
-                            std::string* error);
+                            std::string* error,
+                            const std::vector<char>& without_own_pose = {});
+
+// The own pose's gain above beyond which a frameset's motion leaves it out:
+// the alternation then shrinks the pose's error at least by half per solve
+// (convergence needs |G| < 1; the margin covers the images' unequal weights
+// in the solve, which the mean over images does not see).
+constexpr double kMaxOwnPoseGain = 0.5;
+
+// The framesets whose motion leaves their own pose out (above), for
+// ComputeFramesetMotions' `without_own_pose`: those whose own pose's mean
+// gain |G| over their images exceeds kMaxOwnPoseGain, and every interior
+// one (its window centred on it) when the alternating pattern's mean gain
+// 8/3 (tau / Delta)^2 over every image does. `capture_offsets_s`: per frameset, the instants of its
+// images relative to t_f in seconds (time offset plus line delay times the
+// middle row). None with fewer than three posed framesets.
+std::vector<char> FramesetsWithoutOwnPose(
+    const std::vector<double>& times_s,
+    const std::vector<std::optional<Rigid3d>>& rig_from_world,
+    const std::vector<std::vector<double>>& capture_offsets_s);
 
 // With the final adjustment's time model the rig's translational velocity
 // at each frameset is estimated, not taken from the polynomial: at a 5 Hz

@@ -118,6 +118,10 @@ struct RigCalibration {
   // frameset the rig's estimated translational velocity at the frameset's
   // time, in the rig frame there, map units per second (frameset_motion.h).
   std::vector<Eigen::Vector3d> rig_velocities;
+  // With it, per frameset whether its motion leaves its own pose out
+  // (ComputeFramesetMotions' without_own_pose, as the adjustment's last
+  // motions did); else empty.
+  std::vector<char> frameset_motions_without_own_pose;
 
   Rigid3d CamFromWorld(int camera_index, int frameset_index) const {
     return cam_from_rig[camera_index] * *rig_from_world[frameset_index];

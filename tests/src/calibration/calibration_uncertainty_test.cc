@@ -256,6 +256,48 @@ TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
   ExpectSameSigma(uncertainty, reference);
 }
 
+// A frameset with two inlier correspondences (as at the end of a fast turn,
+// where the synchronized fit kept 3 of a 15 Hz helmet frameset's): its rig
+// pose is not determined and the reduced system is singular there. The
+// frameset is left out with its observations and named, the rig's sigma as
+// with its observations dropped beforehand.
+TEST(CalibrationUncertainty, UndeterminedFramesetPoseIsLeftOutNotFatal) {
+  const SyntheticRig rig =
+      GenerateSyntheticRig(SmallRig(RigPreset::kRing5, 3));
+  RigCalibration calibration = testing::CalibrationAtTruth(rig);
+  ASSERT_TRUE(
+      AdjustRig(QuietAdjustment(), rig.dataset, &calibration, nullptr));
+  constexpr int kFrameset = 4;
+  RigCalibration sparse = calibration, dropped = calibration;
+  int kept = 0;
+  for (size_t i = 0; i < rig.dataset.images.size(); ++i) {
+    if (rig.dataset.images[i].frameset_index != kFrameset) continue;
+    std::vector<char>& mask = sparse.images[i].inlier_mask;
+    for (char& inlier : mask) {
+      if (inlier && kept < 2) {
+        ++kept;
+      } else {
+        inlier = 0;
+      }
+    }
+    std::fill(dropped.images[i].inlier_mask.begin(),
+              dropped.images[i].inlier_mask.end(), 0);
+  }
+  ASSERT_EQ(kept, 2);
+  const CalibrationUncertainty reference =
+      EstimateCalibrationUncertainty(QuietAdjustment(), rig.dataset, dropped);
+  ASSERT_TRUE(reference.computed) << reference.message;
+  const CalibrationUncertainty uncertainty =
+      EstimateCalibrationUncertainty(QuietAdjustment(), rig.dataset, sparse);
+  ASSERT_TRUE(uncertainty.computed) << uncertainty.message;
+  EXPECT_NE(uncertainty.method.find("1 frameset(s)"), std::string::npos)
+      << uncertainty.method;
+  EXPECT_NE(uncertainty.method.find(rig.dataset.frameset_names[kFrameset]),
+            std::string::npos)
+      << uncertainty.method;
+  ExpectSameSigma(uncertainty, reference);
+}
+
 // "framesets_disagree" names the camera whose between-framesets sigma is
 // more than kFramesetsDisagreeFactor times its noise sigma, and only it.
 TEST(CalibrationUncertainty, FramesetsThatDisagreeAreDiagnosed) {

@@ -370,6 +370,36 @@ TEST(CaptureTimeModel, NoisyAt1080RowsNearlyAsAccurateAsSynchronized) {
   ExpectAsAccurateAsSynchronized(1080, 2.0);
 }
 
+// scripts/benchmark_time_model.sh's case (d) at `rate_hz`: seed 0, 60
+// framesets, 1080 rows, offsets in +-50 ms, 20-30 us per row.
+SyntheticRigOptions BenchmarkCaseD(RigPreset preset, double rate_hz) {
+  SyntheticRigOptions options = TimedRingOptions(60, 300, rate_hz);
+  options.preset = preset;
+  options.seed = 0;
+  options.image_height = 1080;
+  options.max_time_offset_s = 0.05;
+  options.min_line_delay_s = 20e-6;
+  options.max_line_delay_s = 30e-6;
+  return options;
+}
+
+// The issue's bounds: every camera's offset within 0.5 ms and line delay
+// within 5 % of the truth.
+void ExpectTimingWithinTheIssuesBounds(const CaptureTimeModel& model,
+                                       const RigGroundTruth& truth) {
+  ASSERT_EQ(model.cameras.size(), truth.time_offsets_s.size());
+  for (size_t c = 0; c < model.cameras.size(); ++c) {
+    EXPECT_LT(std::abs(model.cameras[c].time_offset_s -
+                       truth.time_offsets_s[c]),
+              5e-4)
+        << c;
+    EXPECT_LT(std::abs(model.cameras[c].line_delay_s -
+                       truth.line_delays_s[c]),
+              0.05 * truth.line_delays_s[c])
+        << c;
+  }
+}
+
 // The default method from scratch, every camera's model chosen
 // automatically (auto); refine_points: the map points refined, as the
 // command's default (--RigCalibrator.refine_points 1).
@@ -402,16 +432,9 @@ TEST(CaptureTimeModel, DefaultMethodAndAutomaticModelsFromScratch) {
   const CaptureTimeModel& model = report.capture_time_model;
   std::cout << model.message << std::endl;
   ASSERT_TRUE(model.time_offsets_kept && model.line_delays_kept);
+  ExpectTimingWithinTheIssuesBounds(model, rig.truth);
   for (size_t c = 0; c < 5; ++c) {
     EXPECT_EQ(calibration.cameras[c].ModelName(), "OPENCV") << c;
-    EXPECT_LT(std::abs(model.cameras[c].time_offset_s -
-                       rig.truth.time_offsets_s[c]),
-              5e-4)
-        << c;
-    EXPECT_LT(std::abs(model.cameras[c].line_delay_s -
-                       rig.truth.line_delays_s[c]),
-              0.05 * rig.truth.line_delays_s[c])
-        << c;
   }
   const RigError error = ErrorOfRig(calibration, rig.truth);
   std::cout << "default method, models auto: rig " << error.rotation_deg
@@ -432,13 +455,8 @@ TEST(CaptureTimeModel, DefaultMethodAndAutomaticModelsFromScratch) {
 // 0.03 deg and 0.8 mm (measured 0.022 deg, 0.68 mm). With the refined
 // points everywhere cam2 got OPENCV_FISHEYE and the rig was 0.19 deg off.
 TEST(CaptureTimeModel, DefaultPathAt5HzAnd1080RowsChoosesTheTrueModels) {
-  SyntheticRigOptions options = TimedRingOptions(60, 300, 5);
-  options.seed = 0;
-  options.image_height = 1080;
-  options.max_time_offset_s = 0.05;
-  options.min_line_delay_s = 20e-6;
-  options.max_line_delay_s = 30e-6;
-  SyntheticRig rig = GenerateSyntheticRig(options);
+  SyntheticRig rig =
+      GenerateSyntheticRig(BenchmarkCaseD(RigPreset::kRing5, 5));
   const TimedRun run = CalibrateWithAutomaticModels(&rig, true);
   const RigCalibration& calibration = run.calibration;
   const PipelineReport& report = run.report;
@@ -453,6 +471,33 @@ TEST(CaptureTimeModel, DefaultPathAt5HzAnd1080RowsChoosesTheTrueModels) {
             << " deg, " << error.centre * 1e3 << " mm" << std::endl;
   EXPECT_LT(error.rotation_deg, 0.03);
   EXPECT_LT(error.centre, 0.8e-3);
+}
+
+// The benchmark's helmet case (d) at 15 Hz (scripts/benchmark_time_model.sh
+// with FRAMESET_RATE_HZ=15: seed 0, 60 framesets, 1080 rows, offsets in
+// +-50 ms, 20-30 us per row; default path, points refined). The images are
+// up to 0.8 frameset intervals off the frameset's instant: with every
+// frameset's motion through its own pose, the last frameset (without its
+// reference camera's image) ran 1.6 m off, its rig pose left the
+// uncertainty undetermined, auto kept nothing and the rig was 1.6 deg off
+// (frameset_motion.h). Now offsets within 0.5 ms, line delays within 5 %,
+// the rig within 0.02 deg and 1.2 mm (measured 0.0129 deg, 0.90 mm; the
+// command on the benchmark's files: 0.0109 deg, 0.45 mm, the same rig
+// synchronized 0.0068 deg, 0.33 mm).
+TEST(CaptureTimeModel, DefaultPathAt15HzWithOffsetsNearTheFramesetInterval) {
+  SyntheticRig rig =
+      GenerateSyntheticRig(BenchmarkCaseD(RigPreset::kFisheyeHelmet5, 15));
+  const TimedRun run = CalibrateWithAutomaticModels(&rig, true);
+  const CaptureTimeModel& model = run.report.capture_time_model;
+  ASSERT_TRUE(model.time_offsets_kept && model.line_delays_kept)
+      << model.message;
+  ExpectTimingWithinTheIssuesBounds(model, rig.truth);
+  const RigError error = ErrorOfRig(run.calibration, rig.truth);
+  std::cout << "15 Hz helmet, 1080 rows, models auto: rig "
+            << error.rotation_deg << " deg, " << error.centre * 1e3 << " mm"
+            << std::endl;
+  EXPECT_LT(error.rotation_deg, 0.02);
+  EXPECT_LT(error.centre, 1.2e-3);
 }
 
 // Synchronized global shutters: auto estimates, finds nothing significant

@@ -1,11 +1,14 @@
 // The frameset motion (frameset_motion.h): derivatives exact on a motion
-// the quartic through five framesets represents; the estimated velocities
-// replace p1 and nothing else; the velocity prior's scale over the posed
-// framesets, and its residual and Jacobian (frameset_velocity_prior_cost.h).
+// the quartic through five framesets represents, and on a cubic path
+// without the frameset's own pose, which then does not move its motion; the
+// framesets that leave their own pose out; the estimated velocities replace
+// p1 and nothing else; the velocity prior's scale over the posed framesets,
+// and its residual and Jacobian (frameset_velocity_prior_cost.h).
 #include "src/geometry/frameset_motion.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -60,6 +63,108 @@ TEST(FramesetMotion, ExactForAFixedAxisTurnAndACubicPath) {
       EXPECT_NEAR(motions[f][15 + k], jerk(k), 1e-6) << f;
     }
   }
+}
+
+// Without the own pose (every frameset), the polynomial through the other
+// four: still exact for the fixed-axis turn and the cubic path. A change of
+// a frameset's own position (1e-3 map units per axis) shifts every knot
+// alike and leaves its motion unchanged (to rounding), where with the own
+// pose it moves the velocity by the own weight (at the last frameset
+// 25/12 / Delta times 1e-3, about 0.01). A change of its rotation (1e-3
+// rad per axis) only re-expresses the motion in the turned frame: u1-u3
+// move by less than a fifth of what the own pose's weight moves them.
+TEST(FramesetMotion, WithoutOwnPoseExactAndUnmovedByIt) {
+  const std::vector<double> times = Times();
+  std::vector<std::optional<Rigid3d>> poses;
+  for (const double t : times) poses.push_back(WorldFromRigAt(t).Inverse());
+  const std::vector<char> all(times.size(), 1);
+  std::vector<FramesetMotion> motions, with_own;
+  std::string error;
+  ASSERT_TRUE(ComputeFramesetMotions(times, poses, &motions, &error, all))
+      << error;
+  ASSERT_TRUE(ComputeFramesetMotions(times, poses, &with_own, &error));
+  for (size_t f = 0; f < times.size(); ++f) {
+    for (int k = 0; k < 18; ++k) {
+      // Exact up to the rounding of extrapolated cubics (jerk at the ends).
+      EXPECT_NEAR(motions[f][k], with_own[f][k], k % 9 >= 6 ? 1e-5 : 1e-7)
+          << f << " " << k;
+    }
+  }
+  const Eigen::Vector3d change(1e-3, -1e-3, 1e-3);
+  // The largest change of motion entries [first, last) at frameset f when
+  // its pose is `moved` instead, without and with its own pose.
+  const auto changes = [&](size_t f, const Rigid3d& moved_world_from_rig,
+                           int first, int last) {
+    std::vector<std::optional<Rigid3d>> moved = poses;
+    moved[f] = moved_world_from_rig.Inverse();
+    std::vector<FramesetMotion> without_motions, with_motions;
+    EXPECT_TRUE(
+        ComputeFramesetMotions(times, moved, &without_motions, &error, all));
+    EXPECT_TRUE(ComputeFramesetMotions(times, moved, &with_motions, &error));
+    std::pair<double, double> largest(0, 0);
+    for (int k = first; k < last; ++k) {
+      largest.first = std::max(
+          largest.first, std::abs(without_motions[f][k] - motions[f][k]));
+      largest.second = std::max(
+          largest.second, std::abs(with_motions[f][k] - with_own[f][k]));
+    }
+    return largest;
+  };
+  for (const size_t f : {size_t{0}, size_t{4}, times.size() - 1}) {
+    const Rigid3d world_from_rig = poses[f]->Inverse();
+    const auto [position_without, position_with] =
+        changes(f,
+                Rigid3d(world_from_rig.rotation,
+                        world_from_rig.translation + change),
+                9, 18);
+    EXPECT_LT(position_without, 1e-9) << f;
+    EXPECT_GT(position_with, 1e-3) << f;
+    const auto [rotation_without, rotation_with] = changes(
+        f,
+        Rigid3d(world_from_rig.rotation * Eigen::Quaterniond(ExpSO3(change)),
+                world_from_rig.translation),
+        0, 9);
+    EXPECT_LT(rotation_without, 0.2 * rotation_with) << f;
+  }
+}
+
+// Which framesets leave their own pose out. At 10 Hz, images at the
+// frameset's instant except at the last frameset, whose images are 50 ms
+// late (its own gain 25/12 * 0.5 + 35/12 * 0.125 + 5/2 * 0.02, about 1.5):
+// that one alone. With images at 0 and +-50 ms at 15 Hz (the alternating
+// pattern's gain 8/3 * 0.375 = 1): the interior framesets, whose windows
+// are centred on them, and the first and last (own gain (2.56 - 0.92 + 0)
+// / 3, about 0.55), not the second and the second-to-last (about -0.31).
+// At 5 Hz with the same offsets: none (the last frameset's own gain about
+// 0.05, the alternating 0.11).
+TEST(FramesetMotion, FramesetsWithoutOwnPoseByTheirGain) {
+  const auto evenly = [](double rate_hz) {
+    std::vector<double> times;
+    for (int f = 0; f < 12; ++f) times.push_back(f / rate_hz);
+    return times;
+  };
+  const std::vector<std::optional<Rigid3d>> poses(12, Rigid3d());
+  std::vector<std::vector<double>> offsets(12, {0, 0, 0});
+  offsets.back() = {0.05, 0.05, 0.05};
+  std::vector<char> expected(12, 0);
+  expected.back() = 1;
+  EXPECT_EQ(FramesetsWithoutOwnPose(evenly(10), poses, offsets), expected);
+  offsets.assign(12, {0.0, 0.05, -0.05});
+  expected.assign(12, 1);
+  expected[1] = expected[10] = 0;
+  EXPECT_EQ(FramesetsWithoutOwnPose(evenly(15), poses, offsets), expected);
+  EXPECT_EQ(FramesetsWithoutOwnPose(evenly(5), poses, offsets),
+            std::vector<char>(12, 0));
+  // A frameset without a pose is never marked, nor is any with fewer than
+  // three posed framesets.
+  std::vector<std::optional<Rigid3d>> some = poses;
+  some[3].reset();
+  EXPECT_EQ(FramesetsWithoutOwnPose(evenly(15), some, offsets)[3], 0);
+  std::vector<std::optional<Rigid3d>> two(12);
+  two[0] = Rigid3d();
+  two[5] = Rigid3d();
+  EXPECT_EQ(FramesetsWithoutOwnPose(evenly(15), two, offsets),
+            std::vector<char>(12, 0));
 }
 
 TEST(FramesetMotion, EstimatedVelocitiesReplaceP1Only) {
