@@ -1341,9 +1341,9 @@ CalibrationUncertainty EstimateCalibrationUncertainty(
     // the free world (the map's gauge) to its few points. On the real EuRoC
     // pair one such map image left the uncertainty uncomputed. So is a
     // frameset whose observations do not determine its rig pose (a few
-    // inliers, as at the end of a fast turn where the synchronized fit kept
-    // 3 of a 15 Hz helmet frameset's correspondences); the calibration
-    // loses only that frameset's few observations.
+    // inliers: a 15 Hz helmet's last frameset kept 3 of its correspondences
+    // when the time model's alternation diverged there, frameset_motion.h);
+    // the calibration loses only that frameset's few observations.
     std::vector<char> left_out_map_images(dataset.map_images.size(), 0);
     std::vector<char> left_out_framesets(dataset.frameset_names.size(), 0);
     std::vector<std::string> map_image_names, frameset_names;

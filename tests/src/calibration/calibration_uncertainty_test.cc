@@ -256,8 +256,8 @@ TEST(CalibrationUncertainty, UndeterminedMapImagePoseIsLeftOutNotFatal) {
   ExpectSameSigma(uncertainty, reference);
 }
 
-// A frameset with two inlier correspondences (as at the end of a fast turn,
-// where the synchronized fit kept 3 of a 15 Hz helmet frameset's): its rig
+// A frameset with two inlier correspondences (a 15 Hz helmet's last
+// frameset kept 3 when the time model diverged there): its rig
 // pose is not determined and the reduced system is singular there. The
 // frameset is left out with its observations and named, the rig's sigma as
 // with its observations dropped beforehand.
