@@ -23,11 +23,11 @@
 #include "src/calibration/final_bundle_adjuster.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/geometry/frameset_motion.h"
-#include "src/geometry/frameset_velocity_prior_cost.h"
 #include "src/geometry/pose_jacobians.h"
 #include "src/geometry/rig_reprojection_cost.h"
 #include "src/geometry/tangent_jacobian_cost.h"
 #include "src/geometry/timed_rig_reprojection_cost.h"
+#include "src/geometry/translation_prior_cost.h"
 #include "src/rig/rig_dataset.h"
 #include "src/solvers/bundle_levenberg_marquardt.h"
 #include "src/solvers/huge_page_allocator.h"
@@ -105,7 +105,8 @@ struct Observation {
   // delay (its camera's).
   double* time_offset = nullptr;
   double* line_delay = nullptr;
-  double* velocity = nullptr;  // its frameset's (frameset_motion.h)
+  // Its frameset's estimated velocity and acceleration (frameset_motion.h).
+  double* translation = nullptr;
   int map_camera = -1;  // a map image's camera
   // The cluster of the between-framesets covariance: the frameset of a rig
   // image, num_framesets + m for map image m.
@@ -237,13 +238,15 @@ class UncertaintyProblem {
   // as in the adjustment.
   std::vector<double> time_offsets_, line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
-  // Per frameset the estimated velocity (the result's, else the motion's
-  // p1), a parameter in its rig pose's block, with its prior as in the
-  // adjustment: the scale, the costs, and per prior residual its frameset.
-  std::vector<Eigen::Vector3d> velocities_;
-  double velocity_prior_sigma_ = 1;
-  std::vector<std::unique_ptr<ceres::CostFunction>> velocity_prior_costs_;
-  std::vector<std::pair<int, size_t>> velocity_priors_;
+  // Per frameset the estimated velocity and acceleration (the result's,
+  // else the motion's p1 and p2), a parameter in its rig pose's block, with
+  // its prior as in the adjustment: the whitening, the costs, and per prior
+  // residual its frameset.
+  std::vector<TranslationDerivatives> translations_;
+  Eigen::Matrix<double, 6, 6> translation_prior_whitening_ =
+      Eigen::Matrix<double, 6, 6>::Identity();
+  std::vector<std::unique_ptr<ceres::CostFunction>> translation_prior_costs_;
+  std::vector<std::pair<int, size_t>> translation_priors_;
   LargeVector<Observation> observations_;  // 10^6: huge_page_allocator.h
   std::vector<int64_t> point_ids_;  // refined points in the problem
   std::unordered_map<int64_t, int> point_index_;
@@ -324,16 +327,17 @@ bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
     *error = "the time model's frameset motions: " + *error;
     return false;
   }
-  velocities_ = calibration_.rig_velocities;
-  if (velocities_.size() != frameset_motions_.size()) {
-    velocities_.clear();
+  translations_ = calibration_.rig_translation_derivatives;
+  if (translations_.size() != frameset_motions_.size()) {
+    translations_.clear();
     for (const FramesetMotion& motion : frameset_motions_) {
-      velocities_.emplace_back(motion[9], motion[10], motion[11]);
+      translations_.push_back(
+          Eigen::Map<const TranslationDerivatives>(&motion[9]));
     }
   }
-  // The scale the adjustment's next solve would take.
-  velocity_prior_sigma_ = FramesetVelocityPriorSigma(
-      frameset_motions_, velocities_, calibration_.rig_from_world);
+  // The whitening the adjustment's next solve would take.
+  translation_prior_whitening_ = TranslationPriorWhitening(
+      frameset_motions_, translations_, calibration_.rig_from_world);
   return true;
 }
 
@@ -384,7 +388,7 @@ void UncertaintyProblem::CollectObservations() {
       if (!frameset_motions_.empty()) {
         observation.time_offset = &time_offsets_[c];
         observation.line_delay = &line_delays_[c];
-        observation.velocity = velocities_[image.frameset_index].data();
+        observation.translation = translations_[image.frameset_index].data();
       }
       const auto refined =
           calibration_.refined_points3D.find(correspondence.point3D_id);
@@ -485,8 +489,9 @@ void UncertaintyProblem::AssignBlocks() {
   for (const Observation& observation : observations_) {
     if (observation.rig_camera >= 0) {
       if (options_.refine_rig_poses) {
-        // With the time model the frameset's velocity (3) follows its pose.
-        AddBlock(frameset_motions_.empty() ? 6 : 9, &rig_pose_block_,
+        // With the time model the frameset's velocity and acceleration (6)
+        // follow its pose.
+        AddBlock(frameset_motions_.empty() ? 6 : 12, &rig_pose_block_,
                  observation.cluster);
       }
       camera_observed[observation.rig_camera] = 1;
@@ -573,7 +578,7 @@ void UncertaintyProblem::AddParameterBlocks() {
     solver_->AddParameterBlock(rig_from_world_[f].data(), 7, &pose_manifold_,
                                rig_pose_block_[f]);
     if (!frameset_motions_.empty()) {
-      solver_->AddParameterBlock(velocities_[f].data(), 3, nullptr,
+      solver_->AddParameterBlock(translations_[f].data(), 6, nullptr,
                                  rig_pose_block_[f]);
     }
   }
@@ -652,7 +657,7 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
     if (observation.time_offset != nullptr) {
       parameters.push_back(observation.time_offset);
       parameters.push_back(observation.line_delay);
-      parameters.push_back(observation.velocity);
+      parameters.push_back(observation.translation);
     }
     if (refined) parameters.push_back(points_[observation.point_index].data());
     observation.residual = solver_->AddResidualBlock(
@@ -661,14 +666,13 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
   for (size_t f = 0; f < rig_pose_block_.size() && !frameset_motions_.empty();
        ++f) {
     if (rig_pose_block_[f] < 0) continue;
-    for (const int first_axis : {0, 2}) {
-      velocity_prior_costs_.push_back(
-          std::make_unique<FramesetVelocityPriorCost>(
-              &frameset_motions_[f], &velocity_prior_sigma_, first_axis));
-      velocity_priors_.emplace_back(
+    for (const int first_row : {0, 2, 4}) {
+      translation_prior_costs_.push_back(std::make_unique<TranslationPriorCost>(
+          &frameset_motions_[f], &translation_prior_whitening_, first_row));
+      translation_priors_.emplace_back(
           static_cast<int>(f),
-          solver_->AddResidualBlock(velocity_prior_costs_.back().get(), nullptr,
-                                    {velocities_[f].data()}));
+          solver_->AddResidualBlock(translation_prior_costs_.back().get(),
+                                    nullptr, {translations_[f].data()}));
     }
   }
   if (!solver_->LinearizeGaussNewton(error)) return false;
@@ -960,10 +964,10 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
   for (size_t o = 0; o < observations_.size(); ++o) {
     by_cluster[observations_[o].cluster].push_back(static_cast<int>(o));
   }
-  // A frameset's velocity priors are part of its score, unweighted (no
-  // robust loss).
+  // A frameset's priors of its velocity and acceleration are part of its
+  // score, unweighted (no robust loss).
   std::vector<std::vector<size_t>> priors_by_cluster(num_clusters);
-  for (const auto& [frameset, residual] : velocity_priors_) {
+  for (const auto& [frameset, residual] : translation_priors_) {
     priors_by_cluster[frameset].push_back(residual);
   }
   std::vector<int> clusters;

@@ -283,6 +283,7 @@ bool AdjustRigWithCaptureTimeModel(const CaptureTimeModelOptions& options,
     return false;
   }
   const double interval = MedianFramesetInterval(dataset.frameset_times_s);
+  model->frameset_interval_s = interval;
   if (interval > options.max_frameset_interval_s) {
     std::ostringstream why;
     why << "the framesets are " << std::setprecision(3) << interval
@@ -417,7 +418,7 @@ std::vector<FramesetMotion> AdjustedFramesetMotions(
                                calibration.rig_from_world, &motions, &error,
                                calibration.frameset_motions_without_own_pose))
       << error << " (the capture-time model ran on these poses)";
-  UseFramesetVelocities(calibration.rig_velocities, &motions);
+  UseTranslationDerivatives(calibration.rig_translation_derivatives, &motions);
   return motions;
 }
 

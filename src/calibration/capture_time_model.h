@@ -85,6 +85,18 @@ struct CaptureTimeModelOptions {
   // Above this median interval between consecutive framesets auto does not
   // run (see the top).
   double max_frameset_interval_s = 0.5;
+  // Above this median interval the pipeline warns when offsets are kept
+  // (time_model_framesets_sparse): the framesets do not follow the rig's
+  // motion, and the velocity error common to all framesets, which moves
+  // each camera's centre by its offset times it, is held by the estimates'
+  // prior alone, as if the framesets' deviations were independent. Over 5
+  // synthetic seeds at 5 Hz (scripts/benchmark_time_model_seeds.sh, 1080
+  // rows, offsets in +-50 ms) the rotation errors were 1.3-1.5 times their
+  // sigma (RMS) on every preset, and on the helmet 2 of 5 seeds had
+  // cameras 5-8.6 sigma off along the rig's vertical (up to 2.95 mm); at
+  // 15 Hz (8 seeds) the errors were 0.9-1.2 times their sigma, as
+  // synchronized. 10 Hz lies between the two measured rates.
+  double max_followed_frameset_interval_s = 0.1;
   // Inliers of the start: within this reprojection error of today's result
   // (the pipeline sets the final adjustment's own threshold).
   double inlier_max_error_px = 10.0;
@@ -115,6 +127,8 @@ struct CaptureTimeModel {
   std::vector<bool> line_delay_significant;
   // The adjustment's RMS (pixels) with the time model, and today's.
   double rms_px = 0, rms_without_px = 0;
+  // The median interval between consecutive framesets (seconds).
+  double frameset_interval_s = 0;
   // Why the sigmas are NaN, when they are (the uncertainty's message).
   std::string sigma_error;
   // One line: what was estimated and kept, and why.
@@ -141,8 +155,9 @@ void SetCaptureTimeSigmas(const CalibrationUncertainty& uncertainty,
 
 // The rig's motion at every frameset as the time-model adjustment has it
 // (frameset_motion.h): the polynomial through the calibration's frameset
-// poses, its velocity the estimated one (RigCalibration::rig_velocities;
-// the polynomial's while there is none). For poses the time model runs on
+// poses, its velocity and acceleration the estimated ones
+// (RigCalibration::rig_translation_derivatives; the polynomial's while there
+// are none). For poses the time model runs on
 // (CHECK-fails when the motions cannot be computed, which those exclude).
 std::vector<FramesetMotion> AdjustedFramesetMotions(
     const RigDataset& dataset, const RigCalibration& calibration);

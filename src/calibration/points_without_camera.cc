@@ -32,17 +32,17 @@ bool RayOf(const colmap::Camera& camera, const Rigid3d& cam_from_world,
 // the unit vectors.
 Rigid3d RigFromWorldAtOffset(const Rigid3d& rig_from_world,
                              const FramesetMotion& motion,
-                             const double* velocity, const double tau) {
+                             const double* translation, const double tau) {
   const PoseParams pose = ToPoseParams(rig_from_world);
   Eigen::Vector3d origin;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
-  WorldToRigAtOffset(pose.data(), zero.data(), motion, velocity, tau,
+  WorldToRigAtOffset(pose.data(), zero.data(), motion, translation, tau,
                      origin.data());
   Eigen::Matrix3d rotation;
   for (int k = 0; k < 3; ++k) {
     const Eigen::Vector3d unit = Eigen::Vector3d::Unit(k);
     Eigen::Vector3d image;
-    WorldToRigAtOffset(pose.data(), unit.data(), motion, velocity, tau,
+    WorldToRigAtOffset(pose.data(), unit.data(), motion, translation, tau,
                        image.data());
     rotation.col(k) = image - origin;
   }

@@ -50,11 +50,12 @@ RigAdjustment::RigAdjustment(const FinalBundleAdjustmentOptions& options,
                        ? std::vector<double>(num_cameras, 0.0)
                        : options.initial_line_delays_s;
     frameset_motions_.resize(rig_from_world_.size());
-    frameset_velocities_.assign(rig_from_world_.size(),
-                                Eigen::Vector3d::Zero());
-    if (calibration.rig_velocities.size() == rig_from_world_.size()) {
-      frameset_velocities_ = calibration.rig_velocities;
-      velocities_started_ = true;
+    frameset_translations_.assign(rig_from_world_.size(),
+                                  TranslationDerivatives::Zero());
+    if (calibration.rig_translation_derivatives.size() ==
+        rig_from_world_.size()) {
+      frameset_translations_ = calibration.rig_translation_derivatives;
+      translations_started_ = true;
     }
     UpdateFramesetMotions();
   }
@@ -138,8 +139,8 @@ RigAdjustment::ObservationError RigAdjustment::Evaluate(
     WorldToRigAtOffset(rig_from_world_[image.frameset_index].data(),
                        PointOf(observation).data(),
                        frameset_motions_[image.frameset_index],
-                       frameset_velocities_[image.frameset_index].data(), tau,
-                       point_in_rig.data());
+                       frameset_translations_[image.frameset_index].data(),
+                       tau, point_in_rig.data());
     point_in_cam = FromPoseParams(cam_from_rig_[image.camera_index]) *
                    point_in_rig;
   }
@@ -381,7 +382,7 @@ void RigAdjustment::WriteTo(RigCalibration* calibration) const {
           FromPoseParams(rig_from_world_[frameset]);
     }
   }
-  calibration->rig_velocities = frameset_velocities_;
+  calibration->rig_translation_derivatives = frameset_translations_;
   calibration->frameset_motions_without_own_pose = frameset_without_own_pose_;
   for (size_t i = 0; i < dataset_.images.size(); ++i) {
     ImageResult& result = calibration->images[i];

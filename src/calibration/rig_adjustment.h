@@ -104,12 +104,13 @@ class RigAdjustment {
   using SlotErrors = LargeVector<std::pair<int, ObservationError>>;
 
   // With a time model: the frameset motions (frameset_motion.h) from the
-  // current rig poses and the velocity prior's scale, before each solve;
-  // at the first call the velocities start at the motions' p1 unless given.
+  // current rig poses and the prior's whitening of the estimated velocities
+  // and accelerations, before each solve; at the first call the estimates
+  // start at the motions' p1 and p2 unless given.
   void UpdateFramesetMotions();
-  // The velocity priors (FramesetVelocityPriorCost) of the framesets whose
-  // pose and velocity are refined, after the observations' residuals.
-  void AddVelocityPriors(const std::vector<char>& frameset_refined);
+  // The priors (TranslationPriorCost) of the framesets whose pose, velocity
+  // and acceleration are refined, after the observations' residuals.
+  void AddTranslationPriors(const std::vector<char>& frameset_refined);
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
   int CameraOf(const Observation& observation) const;
@@ -184,16 +185,18 @@ class RigAdjustment {
   // The time model (empty without): per camera its offset and line delay,
   // per frameset its motion from the poses (sized once: the costs point
   // into it), whether that motion leaves the frameset's own pose out, and
-  // its estimated translational velocity, which replaces the motion's p1
-  // (frameset_motion.h); the velocities' prior scale and costs.
+  // its estimated translational velocity and acceleration, which replace
+  // the motion's p1 and p2 (frameset_motion.h); their prior's whitening and
+  // costs.
   std::vector<double> time_offsets_;
   std::vector<double> line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
   std::vector<char> frameset_without_own_pose_;
-  std::vector<Eigen::Vector3d> frameset_velocities_;
-  bool velocities_started_ = false;
-  double velocity_prior_sigma_ = 1;
-  std::vector<std::unique_ptr<ceres::CostFunction>> velocity_prior_costs_;
+  std::vector<TranslationDerivatives> frameset_translations_;
+  bool translations_started_ = false;
+  Eigen::Matrix<double, 6, 6> translation_prior_whitening_ =
+      Eigen::Matrix<double, 6, 6>::Identity();
+  std::vector<std::unique_ptr<ceres::CostFunction>> translation_prior_costs_;
   LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;
   // The map images (empty unless refine_points and map images):

@@ -1,10 +1,11 @@
 // The problem of the final bundle adjustment: one RigReprojectionCost per
 // observation (with a time model a TimedRigReprojectionCost, whose extra
 // blocks are the camera's offset and line delay and the frameset's
-// velocity, which has a prior) (a map image's: its cam_from_world as the
-// "rig" pose, a constant identity cam_from_rig), the blocks that are
-// refined, held or partly held, and its solve by the bundle solver (bundle_solver.h, the
-// options' backend) with the refined points eliminated.
+// velocity and acceleration, which have a prior) (a map image's: its
+// cam_from_world as the "rig" pose, a constant identity cam_from_rig), the
+// blocks that are refined, held or partly held, and its solve by the bundle
+// solver (bundle_solver.h, the options' backend) with the refined points
+// eliminated.
 #include <glog/logging.h>
 
 #include "src/calibration/rig_adjustment.h"
@@ -114,7 +115,7 @@ void RigAdjustment::AddResidualBlocks(
     if (options_.HasTimeModel()) {
       blocks.push_back(&time_offsets_[image.camera_index]);
       blocks.push_back(&line_delays_[image.camera_index]);
-      blocks.push_back(frameset_velocities_[image.frameset_index].data());
+      blocks.push_back(frameset_translations_[image.frameset_index].data());
     }
     if (observation.refined_slot >= 0) {
       blocks.push_back(refined_points_[observation.refined_slot].data());
@@ -143,7 +144,7 @@ void RigAdjustment::AddResidualBlocks(
     for (const Observation& observation : observations_) {
       frameset_refined[dataset_.images[observation.image].frameset_index] = 1;
     }
-    AddVelocityPriors(frameset_refined);
+    AddTranslationPriors(frameset_refined);
   }
 }
 
@@ -191,13 +192,14 @@ void RigAdjustment::AddParameterBlocks(
   }
   int group = 0;
   if (options_.refine_rig_poses) {
-    // With the time model a frameset's velocity is in its pose's group.
+    // With the time model a frameset's velocity and acceleration are in its
+    // pose's group.
     for (size_t frameset = 0; frameset < rig_from_world_.size(); ++frameset) {
       if (!frameset_used[frameset]) continue;
       solver_->AddParameterBlock(rig_from_world_[frameset].data(), 7,
                                  pose_manifold_.get(), group);
       if (options_.HasTimeModel()) {
-        solver_->AddParameterBlock(frameset_velocities_[frameset].data(), 3,
+        solver_->AddParameterBlock(frameset_translations_[frameset].data(), 6,
                                    nullptr, group);
       }
       ++group;

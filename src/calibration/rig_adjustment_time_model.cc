@@ -1,13 +1,14 @@
 // The final bundle adjustment's time model (final_bundle_adjuster.h): the
 // rig's motion around each frameset from the current rig poses, the priors
-// of the estimated velocities, and the estimated offsets and line delays.
+// of the estimated velocities and accelerations, and the estimated offsets
+// and line delays.
 #include <glog/logging.h>
 
 #include <algorithm>
 
 #include "src/calibration/rig_adjustment.h"
-#include "src/geometry/frameset_velocity_prior_cost.h"
 #include "src/geometry/timed_rig_reprojection_cost.h"
+#include "src/geometry/translation_prior_cost.h"
 
 namespace rig_calibrator {
 
@@ -37,30 +38,29 @@ void RigAdjustment::UpdateFramesetMotions() {
                                &error, frameset_without_own_pose_))
       << error << " (checked by AdjustRig)";
   std::copy(motions.begin(), motions.end(), frameset_motions_.begin());
-  velocity_prior_sigma_ = FramesetVelocityPriorSigma(
+  translation_prior_whitening_ = TranslationPriorWhitening(
       motions,
-      velocities_started_ ? frameset_velocities_
-                          : std::vector<Eigen::Vector3d>(),
+      translations_started_ ? frameset_translations_
+                            : std::vector<TranslationDerivatives>(),
       poses);
-  if (!velocities_started_) {
+  if (!translations_started_) {
     for (size_t f = 0; f < motions.size(); ++f) {
-      frameset_velocities_[f] =
-          Eigen::Map<const Eigen::Vector3d>(&motions[f][9]);
+      frameset_translations_[f] =
+          Eigen::Map<const TranslationDerivatives>(&motions[f][9]);
     }
-    velocities_started_ = true;
+    translations_started_ = true;
   }
 }
 
-void RigAdjustment::AddVelocityPriors(
+void RigAdjustment::AddTranslationPriors(
     const std::vector<char>& frameset_refined) {
   for (size_t f = 0; f < frameset_refined.size(); ++f) {
     if (!frameset_refined[f]) continue;
-    for (const int first_axis : {0, 2}) {
-      velocity_prior_costs_.push_back(
-          std::make_unique<FramesetVelocityPriorCost>(
-              &frameset_motions_[f], &velocity_prior_sigma_, first_axis));
-      solver_->AddResidualBlock(velocity_prior_costs_.back().get(), nullptr,
-                                {frameset_velocities_[f].data()});
+    for (const int first_row : {0, 2, 4}) {
+      translation_prior_costs_.push_back(std::make_unique<TranslationPriorCost>(
+          &frameset_motions_[f], &translation_prior_whitening_, first_row));
+      solver_->AddResidualBlock(translation_prior_costs_.back().get(),
+                                nullptr, {frameset_translations_[f].data()});
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "src/geometry/pose_interpolation.h"
@@ -61,6 +62,17 @@ std::vector<int> Knots(const std::vector<int>& posed, int i,
     if (j != i || !without_own_pose || stencil < 3) knots.push_back(posed[j]);
   }
   return knots;
+}
+
+// S^-1/2 = U diag(lambda)^-1/2 U^T for S = U diag(lambda) U^T, each
+// eigenvalue at least `min_variance`.
+Eigen::Matrix3d InverseSquareRoot(const Eigen::Matrix3d& covariance,
+                                  double min_variance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+  const Eigen::Vector3d inverse_deviation =
+      eigen.eigenvalues().cwiseMax(min_variance).cwiseSqrt().cwiseInverse();
+  return eigen.eigenvectors() * inverse_deviation.asDiagonal() *
+         eigen.eigenvectors().transpose();
 }
 
 }  // namespace
@@ -177,33 +189,50 @@ std::vector<char> FramesetsWithoutOwnPose(
   return without;
 }
 
-void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,
-                           std::vector<FramesetMotion>* motions) {
-  if (velocities.size() != motions->size()) return;
+void UseTranslationDerivatives(
+    const std::vector<TranslationDerivatives>& estimates,
+    std::vector<FramesetMotion>* motions) {
+  if (estimates.size() != motions->size()) return;
   for (size_t f = 0; f < motions->size(); ++f) {
-    for (int k = 0; k < 3; ++k) (*motions)[f][9 + k] = velocities[f](k);
+    for (int k = 0; k < 6; ++k) (*motions)[f][9 + k] = estimates[f](k);
   }
 }
 
-double FramesetVelocityPriorSigma(
+Eigen::Matrix<double, 6, 6> TranslationPriorWhitening(
     const std::vector<FramesetMotion>& motions,
-    const std::vector<Eigen::Vector3d>& velocities,
+    const std::vector<TranslationDerivatives>& estimates,
     const std::vector<std::optional<Rigid3d>>& rig_from_world) {
-  double sum_speed = 0, sum_deviation = 0;
+  // Per derivative k (0: velocity p1, 1: acceleration p2).
+  std::array<double, 2> sum_squared = {0, 0};
+  std::array<Eigen::Matrix3d, 2> sum_deviation = {Eigen::Matrix3d::Zero(),
+                                                  Eigen::Matrix3d::Zero()};
+  const bool estimated = estimates.size() == motions.size();
   int count = 0;
   for (size_t f = 0; f < motions.size() && f < rig_from_world.size(); ++f) {
     if (!rig_from_world[f]) continue;
-    const Eigen::Map<const Eigen::Vector3d> p1(&motions[f][9]);
-    sum_speed += p1.squaredNorm();
-    if (velocities.size() == motions.size()) {
-      sum_deviation += (velocities[f] - p1).squaredNorm();
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Map<const Eigen::Vector3d> polynomial(
+          &motions[f][9 + 3 * k]);
+      sum_squared[k] += polynomial.squaredNorm();
+      if (estimated) {
+        const Eigen::Vector3d deviation =
+            estimates[f].segment<3>(3 * k) - polynomial;
+        sum_deviation[k] += deviation * deviation.transpose();
+      }
     }
     ++count;
   }
-  const double speed = count > 0 ? std::sqrt(sum_speed / count) : 0.0;
-  if (!(speed > 0)) return 1.0;
-  if (velocities.size() != motions.size()) return speed;
-  return std::max(std::sqrt(sum_deviation / (3.0 * count)), 0.01 * speed);
+  Eigen::Matrix<double, 6, 6> whitening =
+      Eigen::Matrix<double, 6, 6>::Identity();
+  for (int k = 0; k < 2; ++k) {
+    const double rms = count > 0 ? std::sqrt(sum_squared[k] / count) : 0.0;
+    if (!(rms > 0)) continue;
+    whitening.block<3, 3>(3 * k, 3 * k) =
+        estimated ? InverseSquareRoot(sum_deviation[k] / count,
+                                      0.01 * rms * 0.01 * rms)
+                  : Eigen::Matrix3d(Eigen::Matrix3d::Identity() / rms);
+  }
+  return whitening;
 }
 
 }  // namespace rig_calibrator

@@ -36,7 +36,9 @@
 // through the (up to) five nearest posed framesets (the window shifted
 // inward at the ends; fewer knots lower the degree) of u_j = Log(R_f^T R_j)
 // and p_j = R_f^T (c_j - c_f), differentiated at t_f. Its error is O(Delta^5
-// / Delta^k) for the k-th derivative, Delta the frameset interval.
+// / Delta^k) for the k-th derivative, Delta the frameset interval. The final
+// adjustment estimates the velocity p1 and acceleration p2 instead, with a
+// prior towards these (UseTranslationDerivatives below).
 //
 // The frameset's own pose in that polynomial. The motion is held within a
 // solve and recomputed from the adjusted poses between solves, and through
@@ -127,36 +129,52 @@ std::vector<char> FramesetsWithoutOwnPose(
     const std::vector<std::vector<double>>& capture_offsets_s);
 
 // With the final adjustment's time model the rig's translational velocity
-// at each frameset is estimated, not taken from the polynomial: at a 5 Hz
-// frameset rate the polynomial through the frameset poses misses a walk's
-// bob (its p1 off by 0.25 m/s RMS on the synthetic walk at 1.5 m/s, 20 mm
-// at tau = 80 ms), while u1 and u2 stay within 0.001 rad/s and rad/s^2.
-// The estimate replaces p1 (`velocities`, per frameset, map units per
-// second in the rig frame at t_f; empty: none) for every frameset (one
-// without a pose has zero motion, and its velocity stays zero).
-void UseFramesetVelocities(const std::vector<Eigen::Vector3d>& velocities,
-                           std::vector<FramesetMotion>* motions);
+// and acceleration at each frameset are estimated, not taken from the
+// polynomial: at a 5 Hz frameset rate the polynomial through the frameset
+// poses misses a walk's bob (its p1 off by 0.25 m/s RMS on the synthetic
+// walk at 1.5 m/s, 20 mm at tau = 80 ms; p2 by 1.3 m/s^2), and at 15 Hz a
+// car's 4.8 Hz vibration (1 cm, 9 m/s^2), while u1 and u2 stay within
+// 0.001 rad/s and rad/s^2. [p1, p2], the layout of FramesetMotion's
+// entries 9..14, so that &motion[9] is the polynomial's own.
+using TranslationDerivatives = Eigen::Matrix<double, 6, 1>;
 
-// The scale of the estimated velocities' prior (per axis, map units per
-// second; frameset_velocity_prior_cost.h): over the framesets with a pose,
-// the RMS deviation of the velocities from the polynomial's p1 per axis,
-// sqrt(mean |v_f - p1_f|^2 / 3): an estimate of the polynomial's own error,
-// which is what the prior describes (updated between solves, an EM step for
-// the prior's variance: on the synthetic walk at 5 Hz it settles at 0.16
-// m/s per axis, the polynomial's 0.25 m/s RMS error); at least 1 % of the
-// RMS speed (|p1|), so that it never holds the images off. With
-// `velocities` empty (no estimate yet): the RMS speed. 1 for a rig at rest.
-double FramesetVelocityPriorSigma(
+// The estimates replace p1 and p2 (`estimates`, per frameset, map units
+// per second and per second squared in the rig frame at t_f; empty: none)
+// for every frameset (one without a pose has zero motion, and its estimate
+// stays zero).
+void UseTranslationDerivatives(
+    const std::vector<TranslationDerivatives>& estimates,
+    std::vector<FramesetMotion>* motions);
+
+// The whitening W of the estimated derivatives' prior
+// (translation_prior_cost.h: r = W (e_f - [p1_f, p2_f]) for the
+// estimate e_f), block diagonal: for the velocity, S_v^-1/2 with S_v, over
+// the framesets with a pose, the covariance of the velocities' deviations
+// from the polynomial's p1, mean (v_f - p1_f)(v_f - p1_f)^T, and the same
+// for the acceleration against p2: an estimate of the polynomial's own
+// error, which is what the prior describes (updated between solves, an EM
+// step for the prior's covariance). A covariance, not one scale for every
+// axis, because that error is not the same in every direction: on the
+// synthetic car at 15 Hz (velocities alone estimated) they deviated by
+// 0.22 m/s RMS along the rig's vertical axis (its vibration) and
+// 0.02-0.04 m/s across it, and one scale for all three, 0.13 m/s, moved
+// the centres by 0.64 mm RMS along the vertical over 8 seeds (0.55 mm with
+// the covariance, 0.31 mm with the accelerations estimated too). Each
+// principal deviation at least 1 % of the RMS speed (|p1|; of the RMS
+// acceleration |p2| for the acceleration), so that the prior never holds
+// the images off. With `estimates` empty (no estimate yet): the identity
+// over the RMS speed (acceleration). The identity for a rig at rest.
+Eigen::Matrix<double, 6, 6> TranslationPriorWhitening(
     const std::vector<FramesetMotion>& motions,
-    const std::vector<Eigen::Vector3d>& velocities,
+    const std::vector<TranslationDerivatives>& estimates,
     const std::vector<std::optional<Rigid3d>>& rig_from_world);
 
 // x_rig = Exp(-u(tau)) (Q_f X - p(tau)), with Q_f as [qw, qx, qy, qz, tx,
-// ty, tz] (PoseParams) and p1 = `velocity` (3 values: the motion's own
-// &motion[9], or an estimated velocity), for autodiff and for double.
+// ty, tz] (PoseParams) and [p1, p2] = `translation` (6 values: the
+// motion's own &motion[9], or an estimate), for autodiff and for double.
 template <typename T>
 void WorldToRigAtOffset(const T* rig_from_world, const T* point_in_world,
-                        const FramesetMotion& motion, const T* velocity,
+                        const FramesetMotion& motion, const T* translation,
                         const T& tau, T* point_in_rig) {
   T at_frameset[3];
   ceres::QuaternionRotatePoint(rig_from_world, point_in_world, at_frameset);
@@ -165,7 +183,7 @@ void WorldToRigAtOffset(const T* rig_from_world, const T* point_in_world,
   for (int k = 0; k < 3; ++k) {
     minus_u[k] = -(a1 * motion[k] + a2 * motion[3 + k] + a3 * motion[6 + k]);
     at_frameset[k] += rig_from_world[4 + k] -
-                      (a1 * velocity[k] + a2 * motion[12 + k] +
+                      (a1 * translation[k] + a2 * translation[3 + k] +
                        a3 * motion[15 + k]);
   }
   ceres::AngleAxisRotatePoint(minus_u, at_frameset, point_in_rig);

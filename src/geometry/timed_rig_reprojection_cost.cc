@@ -30,8 +30,8 @@ class TimedRigReprojectionCost final
         motion_(motion) {
     this->set_num_residuals(2);
     *this->mutable_parameter_block_sizes() =
-        variable_point_ ? std::vector<int32_t>{7, 7, kNumParams, 1, 1, 3, 3}
-                        : std::vector<int32_t>{7, 7, kNumParams, 1, 1, 3};
+        variable_point_ ? std::vector<int32_t>{7, 7, kNumParams, 1, 1, 6, 3}
+                        : std::vector<int32_t>{7, 7, kNumParams, 1, 1, 6};
   }
 
   // Evaluate and EvaluateTangent (RigPosesTangentCost): the poses'
@@ -57,7 +57,8 @@ class TimedRigReprojectionCost final
         CaptureTimeOfRow(parameters[3][0], parameters[4][0], observed_.y());
     const double a1 = tau, a2 = tau * tau / 2, a3 = tau * tau * tau / 6;
     const Eigen::Map<const Eigen::Vector3d> u1(&motion[0]), u2(&motion[3]),
-        u3(&motion[6]), p1(parameters[5]), p2(&motion[12]), p3(&motion[15]);
+        u3(&motion[6]), p1(parameters[5]), p2(parameters[5] + 3),
+        p3(&motion[15]);
     const Eigen::Vector3d phi = -(a1 * u1 + a2 * u2 + a3 * u3);
     const Eigen::Vector3d p = a1 * p1 + a2 * p2 + a3 * p3;
 
@@ -109,9 +110,10 @@ class TimedRigReprojectionCost final
       }
     }
     if (jacobians[5] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(
+      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> jacobian(
           jacobians[5]);
-      jacobian = -tau * d_pixel_d_frameset;
+      jacobian.leftCols<3>() = -tau * d_pixel_d_frameset;
+      jacobian.rightCols<3>() = -a2 * d_pixel_d_frameset;
     }
     if (variable_point_ && jacobians[6] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jacobian(

@@ -14,16 +14,16 @@
 //   r = pi_theta(P Exp(-u(tau)) (Q X - p(tau))) - x   (pixels),
 //
 // P = cam_from_rig, Q = rig_from_world of the frameset, theta the camera's
-// COLMAP model parameters, v the frameset's translational velocity (p1 of
-// M_f, estimated: frameset_motion.h), M_f's other coefficients (u1..3,
-// p2, p3) held: they are given by pointer and the adjustment recomputes
-// them between solves.
+// COLMAP model parameters, [v, a] the frameset's translational velocity
+// and acceleration (p1 and p2 of M_f, estimated: frameset_motion.h), M_f's
+// other coefficients (u1..3, p3) held: they are given by pointer and the
+// adjustment recomputes them between solves.
 // The row is the observed y, not the projected one: the two differ by the
 // keypoint's noise, whose effect rho_c |dr/dt| |noise| is 10^-3 px and
 // below (25 us per row, image motion of 100 px/s, 0.5 px of noise).
 //
 // Parameter blocks, in order: Q and P as [qw, qx, qy, qz, tx, ty, tz],
-// theta (the model's kNumParams), delta_c (1), rho_c (1), v (3) and, when
+// theta (the model's kNumParams), delta_c (1), rho_c (1), [v, a] (6) and, when
 // the point is refined, X (3). A block the adjustment does not add (the
 // reference camera's delta, which is 0; rho when rolling shutter is off)
 // is a constant of the solver.
@@ -37,10 +37,11 @@
 //              as there,
 //   dr/dtau  = dr/dz Exp(phi) ([w]x Jr(phi) u'(tau) - p'(tau)),
 //   dr/ddelta = dr/dtau,  dr/drho = dr/dtau (y_obs - 0.5),
-//   dr/dv     = -tau dr/dz Exp(phi)  (p(tau) = tau v + ...),
+//   dr/dv     = -tau dr/dz Exp(phi),  dr/da = -tau^2/2 dr/dz Exp(phi)
+//              (p(tau) = tau v + tau^2/2 a + tau^3/6 p3),
 // from d/dtau Exp(phi) = Exp(phi) [Jr(phi) phi']x (Jr the right Jacobian,
 // pose_interpolation.h), phi' = -u'(tau), u'(tau) = u1 + tau u2 +
-// tau^2/2 u3 and p'(tau) = v + tau p2 + tau^2/2 p3. Why analytic:
+// tau^2/2 u3 and p'(tau) = v + tau a + tau^2/2 p3. Why analytic:
 // automatic Jacobians made a timed iteration 4 times a synchronized one
 // (docs/benchmarks.md).
 // A point that is not in front of the camera is an invalid evaluation.

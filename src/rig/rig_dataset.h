@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "src/geometry/frameset_motion.h"
 #include "src/geometry/rigid3d.h"
 #include "src/rig/intrinsics_refinement.h"
 
@@ -115,9 +116,10 @@ struct RigCalibration {
   std::vector<Rigid3d> map_cam_from_world;
   std::vector<std::vector<char>> map_observation_rejected;
   // After a final bundle adjustment with a time model (else empty): per
-  // frameset the rig's estimated translational velocity at the frameset's
-  // time, in the rig frame there, map units per second (frameset_motion.h).
-  std::vector<Eigen::Vector3d> rig_velocities;
+  // frameset the rig's estimated translational velocity and acceleration
+  // at the frameset's time, in the rig frame there, map units per second
+  // and per second squared (frameset_motion.h).
+  std::vector<TranslationDerivatives> rig_translation_derivatives;
   // With it, per frameset whether its motion leaves its own pose out
   // (ComputeFramesetMotions' without_own_pose, as the adjustment's last
   // motions did); else empty.

@@ -1,9 +1,10 @@
 // The frameset motion (frameset_motion.h): derivatives exact on a motion
 // the quartic through five framesets represents, and on a cubic path
 // without the frameset's own pose, which then does not move its motion; the
-// framesets that leave their own pose out; the estimated velocities replace
-// p1 and nothing else; the velocity prior's scale over the posed framesets,
-// and its residual and Jacobian (frameset_velocity_prior_cost.h).
+// framesets that leave their own pose out; the estimated velocities and
+// accelerations replace p1 and p2 and nothing else; their prior's
+// whitening over the posed framesets, and its residual and Jacobian
+// (translation_prior_cost.h).
 #include "src/geometry/frameset_motion.h"
 
 #include <gtest/gtest.h>
@@ -14,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "src/geometry/frameset_velocity_prior_cost.h"
 #include "src/geometry/pose_interpolation.h"
+#include "src/geometry/translation_prior_cost.h"
 
 namespace rig_calibrator {
 namespace frameset_motion_test {
@@ -167,85 +168,149 @@ TEST(FramesetMotion, FramesetsWithoutOwnPoseByTheirGain) {
             std::vector<char>(12, 0));
 }
 
-TEST(FramesetMotion, EstimatedVelocitiesReplaceP1Only) {
+TEST(FramesetMotion, EstimatedDerivativesReplaceP1AndP2Only) {
   std::vector<FramesetMotion> motions(2);
   for (int k = 0; k < 18; ++k) {
     motions[0][k] = k;
     motions[1][k] = -k;
   }
   const std::vector<FramesetMotion> before = motions;
-  UseFramesetVelocities({}, &motions);  // none: unchanged
+  UseTranslationDerivatives({}, &motions);  // none: unchanged
   EXPECT_EQ(motions, before);
-  UseFramesetVelocities({Eigen::Vector3d(7, 8, 9), Eigen::Vector3d(1, 2, 3)},
-                        &motions);
+  std::vector<TranslationDerivatives> estimates(2);
+  estimates[0] << 7, 8, 9, 10, 11, 12;
+  estimates[1] << 1, 2, 3, 4, 5, 6;
+  UseTranslationDerivatives(estimates, &motions);
   for (int k = 0; k < 18; ++k) {
-    const bool p1 = k >= 9 && k < 12;
-    EXPECT_EQ(motions[0][k], p1 ? 7.0 + (k - 9) : before[0][k]) << k;
-    EXPECT_EQ(motions[1][k], p1 ? 1.0 + (k - 9) : before[1][k]) << k;
+    const bool estimated = k >= 9 && k < 15;
+    EXPECT_EQ(motions[0][k], estimated ? 7.0 + (k - 9) : before[0][k]) << k;
+    EXPECT_EQ(motions[1][k], estimated ? 1.0 + (k - 9) : before[1][k]) << k;
   }
 }
 
-// The prior's scale: the RMS speed before any estimate, then the RMS
-// deviation per axis from p1, at least 1 % of the RMS speed; over the
-// framesets with a pose.
-TEST(FramesetMotion, VelocityPriorSigmaOverThePosedFramesets) {
-  std::vector<FramesetMotion> motions(3);
-  motions[0][9] = 3;   // |p1| = 5
+// The prior's whitening, per derivative (velocity, acceleration): the RMS
+// of the polynomial's before any estimate, then the covariance of the
+// deviations from it to the power -1/2, each principal deviation at least
+// 1 % of that RMS; over the framesets with a pose; nothing between the two.
+TEST(FramesetMotion, TranslationPriorWhiteningOverThePosedFramesets) {
+  std::vector<FramesetMotion> motions(4);
+  motions[0][9] = 3;  // |p1| = 5
   motions[0][10] = 4;
   motions[1][11] = 100;  // no pose: left out
   motions[2][9] = 1;     // |p1| = 1
-  const std::vector<std::optional<Rigid3d>> poses = {Rigid3d(), std::nullopt,
-                                                     Rigid3d()};
-  EXPECT_DOUBLE_EQ(FramesetVelocityPriorSigma(motions, {}, poses),
-                   std::sqrt(13.0));
-  // Deviations |(0, 0, 3)| and |(0, 0, 0)|; frameset 1's is left out.
-  const std::vector<Eigen::Vector3d> velocities = {
-      Eigen::Vector3d(3, 4, 3), Eigen::Vector3d(50, 0, 0),
-      Eigen::Vector3d(1, 0, 0)};
-  EXPECT_DOUBLE_EQ(FramesetVelocityPriorSigma(motions, velocities, poses),
-                   std::sqrt(9.0 / 6));
-  // No deviation: 1 % of the RMS speed.
-  const std::vector<Eigen::Vector3d> on_p1 = {
-      Eigen::Vector3d(3, 4, 0), Eigen::Vector3d::Zero(),
-      Eigen::Vector3d(1, 0, 0)};
-  EXPECT_DOUBLE_EQ(FramesetVelocityPriorSigma(motions, on_p1, poses),
-                   0.01 * std::sqrt(13.0));
-  // At rest, or no pose: 1.
-  EXPECT_EQ(FramesetVelocityPriorSigma(std::vector<FramesetMotion>(3), {},
-                                       poses),
-            1.0);
-  EXPECT_EQ(FramesetVelocityPriorSigma(
-                motions, {}, {std::nullopt, std::nullopt, std::nullopt}),
-            1.0);
+  motions[3][9] = 1;     // |p1| = 1
+  motions[0][14] = 2;    // |p2| = 2, 0, 0
+  const std::vector<std::optional<Rigid3d>> poses = {
+      Rigid3d(), std::nullopt, Rigid3d(), Rigid3d()};
+  const double speed = std::sqrt(27.0 / 3);  // RMS of 5, 1, 1
+  const double acceleration = std::sqrt(4.0 / 3);
+  Eigen::Matrix<double, 6, 6> expected = Eigen::Matrix<double, 6, 6>::Zero();
+  expected.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / speed;
+  expected.bottomRightCorner<3, 3>() =
+      Eigen::Matrix3d::Identity() / acceleration;
+  EXPECT_TRUE(
+      TranslationPriorWhitening(motions, {}, poses).isApprox(expected, 1e-15));
+  // Velocity deviations (0, 3, 3), (0, -3, -3), (0.3, 0, 0): the covariance
+  // has (18 + 18) / 3 = 12 along (0, 1, 1) / sqrt 2 and 0.09 / 3 = 0.03
+  // along x; the third direction, (0, 1, -1) / sqrt 2, none, so 1 % of the
+  // speed. Acceleration deviations (0, 0, 0.6), 0, 0: 0.12 along z, the
+  // floor, 1 % of the RMS acceleration, across it.
+  std::vector<TranslationDerivatives> estimates(4);
+  estimates[0] << 3, 7, 3, 0, 0, 2.6;
+  estimates[1] << 50, 0, 0, 0, 0, 0;
+  estimates[2] << 1, -3, -3, 0, 0, 0;
+  estimates[3] << 1.3, 0, 0, 0, 0, 0;
+  const Eigen::Matrix<double, 6, 6> whitening =
+      TranslationPriorWhitening(motions, estimates, poses);
+  EXPECT_TRUE(whitening.isApprox(whitening.transpose(), 1e-12));
+  EXPECT_TRUE((whitening.topRightCorner<3, 3>().isZero(0)));
+  EXPECT_TRUE((whitening.bottomLeftCorner<3, 3>().isZero(0)));
+  const Eigen::Matrix3d velocity_whitening = whitening.topLeftCorner<3, 3>();
+  const Eigen::Vector3d along = Eigen::Vector3d(0, 1, 1) / std::sqrt(2.0);
+  const Eigen::Vector3d across = Eigen::Vector3d(0, 1, -1) / std::sqrt(2.0);
+  EXPECT_NEAR((velocity_whitening * along).norm(), 1 / std::sqrt(12.0),
+              1e-12);
+  EXPECT_NEAR((velocity_whitening * Eigen::Vector3d::UnitX()).norm(),
+              1 / std::sqrt(0.03), 1e-9);
+  EXPECT_NEAR((velocity_whitening * across).norm(), 1 / (0.01 * speed), 1e-9);
+  EXPECT_NEAR(along.dot(velocity_whitening * Eigen::Vector3d::UnitX()), 0,
+              1e-12);
+  const Eigen::Matrix3d acceleration_whitening =
+      whitening.bottomRightCorner<3, 3>();
+  EXPECT_NEAR((acceleration_whitening * Eigen::Vector3d::UnitZ()).norm(),
+              1 / std::sqrt(0.12), 1e-9);
+  EXPECT_NEAR((acceleration_whitening * Eigen::Vector3d::UnitX()).norm(),
+              1 / (0.01 * acceleration), 1e-7);
+  // The whitened deviations have the identity as their covariance in the
+  // directions above the floor: sum (W d)(W d)^T / n = I there.
+  Eigen::Matrix<double, 6, 6> whitened = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const int f : {0, 2, 3}) {
+    const TranslationDerivatives deviation =
+        whitening * (estimates[f] - Eigen::Map<const TranslationDerivatives>(
+                                        &motions[f][9]));
+    whitened += deviation * deviation.transpose() / 3;
+  }
+  const Eigen::Matrix3d velocity_whitened = whitened.topLeftCorner<3, 3>();
+  EXPECT_NEAR(along.dot(velocity_whitened * along), 1, 1e-12);
+  EXPECT_NEAR(velocity_whitened(0, 0), 1, 1e-12);
+  EXPECT_NEAR(across.dot(velocity_whitened * across), 0, 1e-12);
+  EXPECT_NEAR(whitened(5, 5), 1, 1e-12);
+  // No deviation: 1 % of the RMS in every direction.
+  std::vector<TranslationDerivatives> on_polynomial;
+  for (const FramesetMotion& motion : motions) {
+    on_polynomial.push_back(
+        Eigen::Map<const TranslationDerivatives>(&motion[9]));
+  }
+  EXPECT_TRUE(TranslationPriorWhitening(motions, on_polynomial, poses)
+                  .isApprox(expected / 0.01, 1e-12));
+  // At rest, or no pose: the identity.
+  EXPECT_EQ(TranslationPriorWhitening(std::vector<FramesetMotion>(4), {},
+                                      poses),
+            (Eigen::Matrix<double, 6, 6>::Identity()));
+  EXPECT_EQ(TranslationPriorWhitening(
+                motions, {},
+                {std::nullopt, std::nullopt, std::nullopt, std::nullopt}),
+            (Eigen::Matrix<double, 6, 6>::Identity()));
 }
 
-TEST(FramesetVelocityPriorCost, ResidualAndJacobianPerAxisPair) {
+TEST(TranslationPriorCost, ResidualAndJacobianPerRowPair) {
   FramesetMotion motion{};
-  motion[9] = 1.5;
-  motion[10] = -0.2;
-  motion[11] = 0.4;
-  double sigma = 2.0;
-  const double velocity[3] = {1.9, 0.6, -0.6};
-  const double* parameters[] = {velocity};
-  const FramesetVelocityPriorCost first(&motion, &sigma, 0);
-  const FramesetVelocityPriorCost last(&motion, &sigma, 2);
-  double residuals[2], jacobian[6];
-  double* jacobians[] = {jacobian};
-  ASSERT_TRUE(first.Evaluate(parameters, residuals, jacobians));
-  EXPECT_NEAR(residuals[0], 0.2, 1e-15);
-  EXPECT_NEAR(residuals[1], 0.4, 1e-15);
-  EXPECT_EQ(std::vector<double>(jacobian, jacobian + 6),
-            std::vector<double>({0.5, 0, 0, 0, 0.5, 0}));
-  ASSERT_TRUE(last.Evaluate(parameters, residuals, jacobians));
-  EXPECT_NEAR(residuals[0], -0.5, 1e-15);
-  EXPECT_EQ(residuals[1], 0.0);
-  EXPECT_EQ(std::vector<double>(jacobian, jacobian + 6),
-            std::vector<double>({0, 0, 0.5, 0, 0, 0}));
-  // p1 and sigma are read at every evaluation.
-  motion[11] = -0.6;
-  sigma = 0.5;
+  for (int k = 0; k < 6; ++k) motion[9 + k] = 0.5 * k - 1;  // [p1, p2]
+  // r = W (e - [p1, p2]): rows 0-1, 2-3 and 4-5 in the three costs.
+  Eigen::Matrix<double, 6, 6> whitening;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) whitening(i, j) = i == j ? 2 : 0.1 * (i + j);
+  }
+  double estimate[6];
+  for (int k = 0; k < 6; ++k) estimate[k] = motion[9 + k] + 0.1 * (k + 1);
+  const Eigen::Matrix<double, 6, 1> deviation =
+      Eigen::Matrix<double, 6, 1>::LinSpaced(6, 0.1, 0.6);
+  const Eigen::Matrix<double, 6, 1> expected = whitening * deviation;
+  const double* parameters[] = {estimate};
+  for (const int first_row : {0, 2, 4}) {
+    SCOPED_TRACE(first_row);
+    const TranslationPriorCost cost(&motion, &whitening, first_row);
+    double residuals[2], jacobian[12];
+    double* jacobians[] = {jacobian};
+    ASSERT_TRUE(cost.Evaluate(parameters, residuals, jacobians));
+    for (int row = 0; row < 2; ++row) {
+      EXPECT_NEAR(residuals[row], expected(first_row + row), 1e-14);
+      for (int k = 0; k < 6; ++k) {
+        EXPECT_EQ(jacobian[6 * row + k], whitening(first_row + row, k));
+      }
+    }
+  }
+  // p1, p2 and W are read at every evaluation.
+  const TranslationPriorCost last(&motion, &whitening, 4);
+  for (int k = 0; k < 6; ++k) motion[9 + k] = estimate[k];
+  double residuals[2];
   ASSERT_TRUE(last.Evaluate(parameters, residuals, nullptr));
-  EXPECT_NEAR(residuals[0], 0.0, 1e-15);
+  EXPECT_EQ(residuals[0], 0.0);
+  for (int k = 0; k < 6; ++k) motion[9 + k] = estimate[k] - 1;
+  whitening.setIdentity();
+  ASSERT_TRUE(last.Evaluate(parameters, residuals, nullptr));
+  EXPECT_NEAR(residuals[0], 1, 1e-15);
+  EXPECT_NEAR(residuals[1], 1, 1e-15);
 }
 
 }  // namespace frameset_motion_test

@@ -1,6 +1,6 @@
 // The time model's reprojection cost: its residual and analytic Jacobians
-// (poses on RigPoseManifold, intrinsics, offset, line delay, velocity,
-// point) against
+// (poses on RigPoseManifold, intrinsics, offset, line delay, velocity and
+// acceleration, point) against
 // automatic differentiation of the header's formula, for every kind of
 // camera model, a fixed and a refined point, with and without the constant
 // blocks' Jacobians; a point behind the camera is an invalid evaluation.
@@ -27,10 +27,10 @@ struct AutoDiffTimedError {
   template <typename T>
   bool operator()(const T* rig_from_world, const T* cam_from_rig,
                   const T* params, const T* time_offset, const T* line_delay,
-                  const T* velocity, const T* point, T* residuals) const {
+                  const T* translation, const T* point, T* residuals) const {
     const T tau = CaptureTimeOfRow(time_offset[0], line_delay[0], observed.y());
     T point_in_rig[3], point_in_cam[3];
-    WorldToRigAtOffset(rig_from_world, point, *motion, velocity, tau,
+    WorldToRigAtOffset(rig_from_world, point, *motion, translation, tau,
                        point_in_rig);
     ceres::QuaternionRotatePoint(cam_from_rig, point_in_rig, point_in_cam);
     for (int k = 0; k < 3; ++k) point_in_cam[k] += cam_from_rig[4 + k];
@@ -82,29 +82,31 @@ void ExpectJacobiansMatchAutoDiff() {
                                  -4.0, 3.0, 6.0,  1.5, -0.2, 0.1,
                                  0.4, 2.0, -0.5, -3.0, 1.0, 5.0};
   double time_offset = 0.041, line_delay = 27e-6;
-  // The estimated velocity, which replaces the motion's p1.
-  Eigen::Vector3d velocity(1.2, 0.3, -0.4);
+  // The estimated velocity and acceleration, which replace the motion's p1
+  // and p2.
+  TranslationDerivatives translation;
+  translation << 1.2, 0.3, -0.4, 1.5, -2.5, 0.7;
   std::array<double, 7> rig_block = PoseBlock(rig_from_world);
   std::array<double, 7> cam_block = PoseBlock(cam_from_rig);
   const Eigen::Vector2d observed(100, 400.3);
   const double* parameters[] = {rig_block.data(), cam_block.data(),
                                 camera.ParamsData(), &time_offset,
-                                &line_delay,        velocity.data(),
+                                &line_delay,        translation.data(),
                                 point3D.data()};
 
   Eigen::Vector2d expected_residual;
   Eigen::Matrix<double, 2, 7, Eigen::RowMajor> expected_rig, expected_cam;
   Eigen::Matrix<double, 2, kNumParams, Eigen::RowMajor> expected_params;
   Eigen::Vector2d expected_offset, expected_delay;
-  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> expected_velocity,
-      expected_point;
+  Eigen::Matrix<double, 2, 6, Eigen::RowMajor> expected_translation;
+  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> expected_point;
   double* expected_jacobians[] = {
       expected_rig.data(),      expected_cam.data(),
       expected_params.data(),   expected_offset.data(),
-      expected_delay.data(),    expected_velocity.data(),
+      expected_delay.data(),    expected_translation.data(),
       expected_point.data()};
   ceres::AutoDiffCostFunction<AutoDiffTimedError<CameraModel>, 2, 7, 7,
-                              kNumParams, 1, 1, 3, 3>
+                              kNumParams, 1, 1, 6, 3>
       reference(new AutoDiffTimedError<CameraModel>{observed, &motion});
   ASSERT_TRUE(reference.Evaluate(parameters, expected_residual.data(),
                                  expected_jacobians));
@@ -131,11 +133,11 @@ void ExpectJacobiansMatchAutoDiff() {
       Eigen::Matrix<double, 2, 7, Eigen::RowMajor> rig_jacobian, cam_jacobian;
       Eigen::Matrix<double, 2, kNumParams, Eigen::RowMajor> params_jacobian;
       Eigen::Vector2d offset_jacobian, delay_jacobian;
-      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> velocity_jacobian,
-          point_jacobian;
+      Eigen::Matrix<double, 2, 6, Eigen::RowMajor> translation_jacobian;
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> point_jacobian;
       double* jacobians[] = {rig_jacobian.data(),      cam_jacobian.data(),
                              params_jacobian.data(),   offset_jacobian.data(),
-                             delay_jacobian.data(),    velocity_jacobian.data(),
+                             delay_jacobian.data(),    translation_jacobian.data(),
                              point_jacobian.data()};
       ASSERT_TRUE(tangent ? tangent_cost->EvaluateTangent(
                                 parameters, residual.data(), jacobians)
@@ -165,8 +167,8 @@ void ExpectJacobiansMatchAutoDiff() {
                 1e-9 * expected_offset.norm());
       EXPECT_LT((delay_jacobian - expected_delay).norm(),
                 1e-9 * expected_delay.norm());
-      EXPECT_LT((velocity_jacobian - expected_velocity).norm(),
-                1e-10 * expected_velocity.norm());
+      EXPECT_LT((translation_jacobian - expected_translation).norm(),
+                1e-10 * expected_translation.norm());
       if (variable_point) {
         EXPECT_LT((point_jacobian - expected_point).norm(), scale);
       }
