@@ -240,11 +240,10 @@ class UncertaintyProblem {
   std::vector<FramesetMotion> frameset_motions_;
   // Per frameset the estimated velocity and acceleration (the result's,
   // else the motion's p1 and p2), a parameter in its rig pose's block, with
-  // its prior as in the adjustment: the whitening, the costs, and per prior
-  // residual its frameset.
+  // its prior as in the adjustment: the autoregression, the costs, and per
+  // prior residual its frameset.
   std::vector<TranslationDerivatives> translations_;
-  Eigen::Matrix<double, 6, 6> translation_prior_whitening_ =
-      Eigen::Matrix<double, 6, 6>::Identity();
+  TranslationPrior translation_prior_;
   std::vector<std::unique_ptr<ceres::CostFunction>> translation_prior_costs_;
   std::vector<std::pair<int, size_t>> translation_priors_;
   LargeVector<Observation> observations_;  // 10^6: huge_page_allocator.h
@@ -335,8 +334,8 @@ bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
           Eigen::Map<const TranslationDerivatives>(&motion[9]));
     }
   }
-  // The whitening the adjustment's next solve would take.
-  translation_prior_whitening_ = TranslationPriorWhitening(
+  // The prior the adjustment's next solve would take.
+  translation_prior_ = EstimateTranslationPrior(
       frameset_motions_, translations_, calibration_.rig_from_world);
   return true;
 }
@@ -666,13 +665,25 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
   for (size_t f = 0; f < rig_pose_block_.size() && !frameset_motions_.empty();
        ++f) {
     if (rig_pose_block_[f] < 0) continue;
+    // As the adjustment's (RigAdjustment::AddTranslationPriors).
+    const bool after_previous = f > 0 && rig_pose_block_[f - 1] >= 0;
     for (const int first_row : {0, 2, 4}) {
-      translation_prior_costs_.push_back(std::make_unique<TranslationPriorCost>(
-          &frameset_motions_[f], &translation_prior_whitening_, first_row));
+      std::vector<double*> blocks = {translations_[f].data()};
+      if (after_previous) {
+        translation_prior_costs_.push_back(
+            std::make_unique<TranslationInnovationCost>(
+                &frameset_motions_[f], &frameset_motions_[f - 1],
+                &translation_prior_, first_row));
+        blocks.push_back(translations_[f - 1].data());
+      } else {
+        translation_prior_costs_.push_back(
+            std::make_unique<TranslationPriorCost>(
+                &frameset_motions_[f], &translation_prior_, first_row));
+      }
       translation_priors_.emplace_back(
           static_cast<int>(f),
           solver_->AddResidualBlock(translation_prior_costs_.back().get(),
-                                    nullptr, {translations_[f].data()}));
+                                    nullptr, blocks));
     }
   }
   if (!solver_->LinearizeGaussNewton(error)) return false;
@@ -965,7 +976,9 @@ void UncertaintyProblem::BetweenFramesetsCovariance(
     by_cluster[observations_[o].cluster].push_back(static_cast<int>(o));
   }
   // A frameset's priors of its velocity and acceleration are part of its
-  // score, unweighted (no robust loss).
+  // score, unweighted (no robust loss); its innovation cost's too, whose
+  // gradient reaches the previous frameset's parameters: the innovations
+  // are what the prior takes as independent.
   std::vector<std::vector<size_t>> priors_by_cluster(num_clusters);
   for (const auto& [frameset, residual] : translation_priors_) {
     priors_by_cluster[frameset].push_back(residual);

@@ -89,13 +89,13 @@ struct CaptureTimeModelOptions {
   // (time_model_framesets_sparse): the framesets do not follow the rig's
   // motion, and the velocity error common to all framesets, which moves
   // each camera's centre by its offset times it, is held by the estimates'
-  // prior alone, as if the framesets' deviations were independent. Over 5
-  // synthetic seeds at 5 Hz (scripts/benchmark_time_model_seeds.sh, 1080
-  // rows, offsets in +-50 ms) the rotation errors were 1.3-1.5 times their
-  // sigma (RMS) on every preset, and on the helmet 2 of 5 seeds had
-  // cameras 5-8.6 sigma off along the rig's vertical (up to 2.95 mm); at
-  // 15 Hz (8 seeds) the errors were 0.9-1.2 times their sigma, as
-  // synchronized. 10 Hz lies between the two measured rates.
+  // prior alone. Over 5 synthetic seeds at 5 Hz
+  // (scripts/benchmark_time_model_seeds.sh, 1080 rows, offsets in +-50 ms)
+  // the rotation errors were 1.4-1.5 times their sigma (RMS) on the ring
+  // and the car (1.0 on the helmet, whose cameras were up to 8.6 sigma off
+  // before the prior followed the deviations from frameset to frameset,
+  // frameset_motion.h); at 15 Hz (8 seeds) 1.1-1.2, as synchronized
+  // (1.0-1.1). 10 Hz lies between the two measured rates.
   double max_followed_frameset_interval_s = 0.1;
   // Inliers of the start: within this reprojection error of today's result
   // (the pipeline sets the final adjustment's own threshold).

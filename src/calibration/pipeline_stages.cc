@@ -403,8 +403,8 @@ bool RunCaptureTimeModel(const PipelineOptions& options,
                "model's offsets hold each camera's centre against the rig's "
                "velocity only as well as its prior does; the sigmas of "
                "cam_from_rig can be too small (on synthetic rigs at 5 Hz the "
-               "rotation errors were 1.3-1.5 sigma RMS, and centres up to 8.6 "
-               "sigma off along the axis the rig turns about). Record "
+               "rotation errors were 1.4-1.5 sigma RMS on two of three "
+               "presets). Record "
                "framesets at 15 Hz or faster, or compare with a calibration "
                "from other framesets";
     AddDiagnostic(report, Diagnostic::Level::kWarning,

@@ -104,12 +104,14 @@ class RigAdjustment {
   using SlotErrors = LargeVector<std::pair<int, ObservationError>>;
 
   // With a time model: the frameset motions (frameset_motion.h) from the
-  // current rig poses and the prior's whitening of the estimated velocities
-  // and accelerations, before each solve; at the first call the estimates
-  // start at the motions' p1 and p2 unless given.
+  // current rig poses and the prior of the estimated velocities and
+  // accelerations (EstimateTranslationPrior), before each solve; at the
+  // first call the estimates start at the motions' p1 and p2 unless given.
   void UpdateFramesetMotions();
-  // The priors (TranslationPriorCost) of the framesets whose pose, velocity
-  // and acceleration are refined, after the observations' residuals.
+  // The priors (translation_prior_cost.h) of the framesets whose pose,
+  // velocity and acceleration are refined, after the observations'
+  // residuals: an innovation cost where the previous frameset is refined
+  // too, else the frameset's own.
   void AddTranslationPriors(const std::vector<char>& frameset_refined);
 
   const Correspondence& CorrespondenceOf(const Observation& observation) const;
@@ -194,8 +196,7 @@ class RigAdjustment {
   std::vector<char> frameset_without_own_pose_;
   std::vector<TranslationDerivatives> frameset_translations_;
   bool translations_started_ = false;
-  Eigen::Matrix<double, 6, 6> translation_prior_whitening_ =
-      Eigen::Matrix<double, 6, 6>::Identity();
+  TranslationPrior translation_prior_;
   std::vector<std::unique_ptr<ceres::CostFunction>> translation_prior_costs_;
   LargeVector<Observation> observations_;
   size_t num_given_inliers_ = 0;

@@ -38,7 +38,7 @@ void RigAdjustment::UpdateFramesetMotions() {
                                &error, frameset_without_own_pose_))
       << error << " (checked by AdjustRig)";
   std::copy(motions.begin(), motions.end(), frameset_motions_.begin());
-  translation_prior_whitening_ = TranslationPriorWhitening(
+  translation_prior_ = EstimateTranslationPrior(
       motions,
       translations_started_ ? frameset_translations_
                             : std::vector<TranslationDerivatives>(),
@@ -56,11 +56,22 @@ void RigAdjustment::AddTranslationPriors(
     const std::vector<char>& frameset_refined) {
   for (size_t f = 0; f < frameset_refined.size(); ++f) {
     if (!frameset_refined[f]) continue;
+    const bool after_previous = f > 0 && frameset_refined[f - 1];
     for (const int first_row : {0, 2, 4}) {
-      translation_prior_costs_.push_back(std::make_unique<TranslationPriorCost>(
-          &frameset_motions_[f], &translation_prior_whitening_, first_row));
-      solver_->AddResidualBlock(translation_prior_costs_.back().get(),
-                                nullptr, {frameset_translations_[f].data()});
+      std::vector<double*> blocks = {frameset_translations_[f].data()};
+      if (after_previous) {
+        translation_prior_costs_.push_back(
+            std::make_unique<TranslationInnovationCost>(
+                &frameset_motions_[f], &frameset_motions_[f - 1],
+                &translation_prior_, first_row));
+        blocks.push_back(frameset_translations_[f - 1].data());
+      } else {
+        translation_prior_costs_.push_back(
+            std::make_unique<TranslationPriorCost>(
+                &frameset_motions_[f], &translation_prior_, first_row));
+      }
+      solver_->AddResidualBlock(translation_prior_costs_.back().get(), nullptr,
+                                blocks);
     }
   }
 }

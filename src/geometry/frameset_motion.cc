@@ -198,41 +198,88 @@ void UseTranslationDerivatives(
   }
 }
 
-Eigen::Matrix<double, 6, 6> TranslationPriorWhitening(
+TranslationPrior EstimateTranslationPrior(
     const std::vector<FramesetMotion>& motions,
     const std::vector<TranslationDerivatives>& estimates,
     const std::vector<std::optional<Rigid3d>>& rig_from_world) {
-  // Per derivative k (0: velocity p1, 1: acceleration p2).
-  std::array<double, 2> sum_squared = {0, 0};
-  std::array<Eigen::Matrix3d, 2> sum_deviation = {Eigen::Matrix3d::Zero(),
-                                                  Eigen::Matrix3d::Zero()};
+  const size_t num_framesets = std::min(motions.size(), rig_from_world.size());
   const bool estimated = estimates.size() == motions.size();
+  std::vector<TranslationDerivatives> deviations(num_framesets,
+                                                 TranslationDerivatives::Zero());
+  std::array<double, 2> sum_squared = {0, 0};
   int count = 0;
-  for (size_t f = 0; f < motions.size() && f < rig_from_world.size(); ++f) {
+  for (size_t f = 0; f < num_framesets; ++f) {
     if (!rig_from_world[f]) continue;
+    const Eigen::Map<const TranslationDerivatives> polynomial(&motions[f][9]);
     for (int k = 0; k < 2; ++k) {
-      const Eigen::Map<const Eigen::Vector3d> polynomial(
-          &motions[f][9 + 3 * k]);
-      sum_squared[k] += polynomial.squaredNorm();
-      if (estimated) {
-        const Eigen::Vector3d deviation =
-            estimates[f].segment<3>(3 * k) - polynomial;
-        sum_deviation[k] += deviation * deviation.transpose();
-      }
+      sum_squared[k] += polynomial.segment<3>(3 * k).squaredNorm();
     }
+    if (estimated) deviations[f] = estimates[f] - polynomial;
     ++count;
   }
-  Eigen::Matrix<double, 6, 6> whitening =
-      Eigen::Matrix<double, 6, 6>::Identity();
+  TranslationPrior prior;
   for (int k = 0; k < 2; ++k) {
     const double rms = count > 0 ? std::sqrt(sum_squared[k] / count) : 0.0;
     if (!(rms > 0)) continue;
-    whitening.block<3, 3>(3 * k, 3 * k) =
-        estimated ? InverseSquareRoot(sum_deviation[k] / count,
-                                      0.01 * rms * 0.01 * rms)
-                  : Eigen::Matrix3d(Eigen::Matrix3d::Identity() / rms);
+    const double min_variance = 0.01 * rms * 0.01 * rms;
+    if (!estimated) {
+      prior.whitening.block<3, 3>(3 * k, 3 * k) =
+          Eigen::Matrix3d::Identity() / rms;
+      prior.innovation_whitening.block<3, 3>(3 * k, 3 * k) =
+          Eigen::Matrix3d::Identity() / rms;
+      continue;
+    }
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (size_t f = 0; f < num_framesets; ++f) {
+      if (!rig_from_world[f]) continue;
+      const Eigen::Vector3d d = deviations[f].segment<3>(3 * k);
+      covariance += d * d.transpose();
+    }
+    covariance /= count;
+    const Eigen::Matrix3d whitening =
+        InverseSquareRoot(covariance, min_variance);
+    prior.whitening.block<3, 3>(3 * k, 3 * k) = whitening;
+    prior.innovation_whitening.block<3, 3>(3 * k, 3 * k) = whitening;
+    // Phi = U diag(phi) U^T, phi_j along S_d's principal axis u_j: the
+    // regression of u_j^T d_f on u_j^T d_(f-1) over the consecutive pairs.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes(covariance);
+    const Eigen::Matrix3d& to_axes = axes.eigenvectors();
+    Eigen::Array3d lagged = Eigen::Array3d::Zero();
+    Eigen::Array3d previous = Eigen::Array3d::Zero();
+    int num_pairs = 0;
+    for (size_t f = 1; f < num_framesets; ++f) {
+      if (!rig_from_world[f] || !rig_from_world[f - 1]) continue;
+      const Eigen::Array3d w =
+          (to_axes.transpose() * deviations[f].segment<3>(3 * k)).array();
+      const Eigen::Array3d w_previous =
+          (to_axes.transpose() * deviations[f - 1].segment<3>(3 * k)).array();
+      lagged += w * w_previous;
+      previous += w_previous.square();
+      ++num_pairs;
+    }
+    if (num_pairs < kMinTranslationPriorPairs) continue;
+    // Negative only (see the header): a positive correlation is what the
+    // prior's own smoothing of the estimates creates.
+    const Eigen::Vector3d correlation =
+        (lagged / (previous + num_pairs * min_variance))
+            .cwiseMax(-kMaxTranslationPriorCorrelation)
+            .cwiseMin(0.0)
+            .matrix();
+    const Eigen::Matrix3d gain =
+        to_axes * correlation.asDiagonal() * to_axes.transpose();
+    Eigen::Matrix3d innovations = Eigen::Matrix3d::Zero();
+    for (size_t f = 1; f < num_framesets; ++f) {
+      if (!rig_from_world[f] || !rig_from_world[f - 1]) continue;
+      const Eigen::Vector3d innovation =
+          deviations[f].segment<3>(3 * k) -
+          gain * deviations[f - 1].segment<3>(3 * k);
+      innovations += innovation * innovation.transpose();
+    }
+    prior.predecessor_gain.block<3, 3>(3 * k, 3 * k) = gain;
+    prior.innovation_whitening.block<3, 3>(3 * k, 3 * k) =
+        InverseSquareRoot(innovations / num_pairs, min_variance);
   }
-  return whitening;
+  return prior;
 }
 
 }  // namespace rig_calibrator

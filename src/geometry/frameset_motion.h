@@ -146,25 +146,70 @@ void UseTranslationDerivatives(
     const std::vector<TranslationDerivatives>& estimates,
     std::vector<FramesetMotion>* motions);
 
-// The whitening W of the estimated derivatives' prior
-// (translation_prior_cost.h: r = W (e_f - [p1_f, p2_f]) for the
-// estimate e_f), block diagonal: for the velocity, S_v^-1/2 with S_v, over
-// the framesets with a pose, the covariance of the velocities' deviations
-// from the polynomial's p1, mean (v_f - p1_f)(v_f - p1_f)^T, and the same
-// for the acceleration against p2: an estimate of the polynomial's own
-// error, which is what the prior describes (updated between solves, an EM
-// step for the prior's covariance). A covariance, not one scale for every
-// axis, because that error is not the same in every direction: on the
-// synthetic car at 15 Hz (velocities alone estimated) they deviated by
-// 0.22 m/s RMS along the rig's vertical axis (its vibration) and
-// 0.02-0.04 m/s across it, and one scale for all three, 0.13 m/s, moved
-// the centres by 0.64 mm RMS along the vertical over 8 seeds (0.55 mm with
-// the covariance, 0.31 mm with the accelerations estimated too). Each
-// principal deviation at least 1 % of the RMS speed (|p1|; of the RMS
-// acceleration |p2| for the acceleration), so that the prior never holds
-// the images off. With `estimates` empty (no estimate yet): the identity
-// over the RMS speed (acceleration). The identity for a rig at rest.
-Eigen::Matrix<double, 6, 6> TranslationPriorWhitening(
+// The prior of the estimated derivatives (translation_prior_cost.h): the
+// polynomial's error d_f = e_f - [p1_f, p2_f] (e_f the estimate) as a
+// Gaussian first-order autoregression from one frameset to the next,
+//
+//   d_f = Phi d_(f-1) + i_f,   i_f ~ N(0, S_i)   (f - 1 and f with a pose),
+//   d_f ~ N(0, S_d)   (a frameset whose predecessor has none),
+//
+// so that the prior's residuals are W_d d_f at the first frameset of each
+// run and W_i (d_f - Phi d_(f-1)) after it (W = S^-1/2), each block
+// diagonal: the velocity apart from the acceleration.
+//
+// Why a covariance, not one scale for every axis: the error differs by
+// direction. On the synthetic car at 15 Hz (velocities alone estimated)
+// the velocities deviated by 0.22 m/s RMS along the rig's vertical axis
+// (its vibration) and 0.02-0.04 m/s across it, and one scale for all
+// three, 0.13 m/s, moved the centres by 0.64 mm RMS along the vertical
+// over 8 seeds (0.55 mm with the covariance, 0.31 mm with the
+// accelerations estimated too).
+//
+// Why from frameset to frameset: the polynomial's error is not independent
+// across framesets. For a motion of frequency omega (a walk's bob, a car's
+// vibration) the stencil's error is a sinusoid of the same frequency, whose
+// lag-1 correlation is cos(omega Delta), negative when the framesets sample
+// the motion fewer than four times a period: at the end of the adjustment
+// of the synthetic helmet at 5 Hz (seed 4) -0.76 along the rig's vertical.
+// The prior is what holds the velocity error common to all framesets, which
+// moves each camera by its offset times it exactly as a change of its
+// centre does: taken as independent it holds it to S_d^1/2 / sqrt(n) over n
+// framesets, the autoregression to that times sqrt((1 + phi) / (1 - phi)),
+// 2.7 times tighter at phi = -0.76. On that helmet the cameras' centres were
+// 5-8.6 sigma off along the vertical (up to 2.95 mm) with the independent
+// prior, and within 2 sigma (0.40 mm) with it.
+//
+// Estimated from the current estimates (updated between solves, an EM step
+// for the prior): S_d the mean d_f d_f^T over the framesets with a pose;
+// Phi = U diag(phi) U^T with U S_d's principal axes and phi_j the
+// least-squares regression of u_j^T d_f on u_j^T d_(f-1) over the
+// consecutive pairs (none with fewer than kMinTranslationPriorPairs), in
+// [-kMaxTranslationPriorCorrelation, 0]; S_i the mean of the innovations'
+// i_f i_f^T. Why not positive: the estimates are the adjustment's, which
+// the prior itself smooths, and smoothing makes neighbours alike; a
+// positive phi, read from them, loosens the prior of the common error, and
+// the next step reads a larger one (on the helmet at 15 Hz, seed 1, the
+// acceleration's phi went to the cap, 0.9, in three steps). A principal
+// axis, not a full regression matrix: with 60 framesets the cross terms
+// from an axis of small deviations onto one of large ones came out above 1
+// (a singular value of 13 on the same helmet). Each principal deviation at
+// least 1 % of the RMS speed (|p1|; of the RMS acceleration |p2| for the
+// acceleration), so that the prior never holds the images off. Without
+// estimates (`estimates` empty): the identity over the RMS speed
+// (acceleration) for W_d and W_i, Phi = 0. The identity for a rig at rest.
+struct TranslationPrior {
+  Eigen::Matrix<double, 6, 6> whitening =  // W_d
+      Eigen::Matrix<double, 6, 6>::Identity();
+  Eigen::Matrix<double, 6, 6> predecessor_gain =  // Phi
+      Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> innovation_whitening =  // W_i
+      Eigen::Matrix<double, 6, 6>::Identity();
+};
+
+constexpr int kMinTranslationPriorPairs = 10;
+constexpr double kMaxTranslationPriorCorrelation = 0.9;
+
+TranslationPrior EstimateTranslationPrior(
     const std::vector<FramesetMotion>& motions,
     const std::vector<TranslationDerivatives>& estimates,
     const std::vector<std::optional<Rigid3d>>& rig_from_world);

@@ -2,9 +2,10 @@
 // the quartic through five framesets represents, and on a cubic path
 // without the frameset's own pose, which then does not move its motion; the
 // framesets that leave their own pose out; the estimated velocities and
-// accelerations replace p1 and p2 and nothing else; their prior's
-// whitening over the posed framesets, and its residual and Jacobian
-// (translation_prior_cost.h).
+// accelerations replace p1 and p2 and nothing else; their prior over the
+// posed framesets (its whitening, and its autoregression from frameset to
+// frameset recovered exactly, statistically and capped), and its costs'
+// residuals and Jacobians (translation_prior_cost.h).
 #include "src/geometry/frameset_motion.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -192,6 +194,8 @@ TEST(FramesetMotion, EstimatedDerivativesReplaceP1AndP2Only) {
 // of the polynomial's before any estimate, then the covariance of the
 // deviations from it to the power -1/2, each principal deviation at least
 // 1 % of that RMS; over the framesets with a pose; nothing between the two.
+// Fewer than kMinTranslationPriorPairs consecutive pairs: no autoregression,
+// the innovations' whitening is the deviations'.
 TEST(FramesetMotion, TranslationPriorWhiteningOverThePosedFramesets) {
   std::vector<FramesetMotion> motions(4);
   motions[0][9] = 3;  // |p1| = 5
@@ -208,8 +212,10 @@ TEST(FramesetMotion, TranslationPriorWhiteningOverThePosedFramesets) {
   expected.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / speed;
   expected.bottomRightCorner<3, 3>() =
       Eigen::Matrix3d::Identity() / acceleration;
-  EXPECT_TRUE(
-      TranslationPriorWhitening(motions, {}, poses).isApprox(expected, 1e-15));
+  const TranslationPrior before = EstimateTranslationPrior(motions, {}, poses);
+  EXPECT_TRUE(before.whitening.isApprox(expected, 1e-15));
+  EXPECT_TRUE(before.innovation_whitening.isApprox(expected, 1e-15));
+  EXPECT_TRUE(before.predecessor_gain.isZero(0));
   // Velocity deviations (0, 3, 3), (0, -3, -3), (0.3, 0, 0): the covariance
   // has (18 + 18) / 3 = 12 along (0, 1, 1) / sqrt 2 and 0.09 / 3 = 0.03
   // along x; the third direction, (0, 1, -1) / sqrt 2, none, so 1 % of the
@@ -220,8 +226,11 @@ TEST(FramesetMotion, TranslationPriorWhiteningOverThePosedFramesets) {
   estimates[1] << 50, 0, 0, 0, 0, 0;
   estimates[2] << 1, -3, -3, 0, 0, 0;
   estimates[3] << 1.3, 0, 0, 0, 0, 0;
-  const Eigen::Matrix<double, 6, 6> whitening =
-      TranslationPriorWhitening(motions, estimates, poses);
+  const TranslationPrior prior =
+      EstimateTranslationPrior(motions, estimates, poses);
+  EXPECT_TRUE(prior.predecessor_gain.isZero(0));
+  EXPECT_EQ(prior.innovation_whitening, prior.whitening);
+  const Eigen::Matrix<double, 6, 6>& whitening = prior.whitening;
   EXPECT_TRUE(whitening.isApprox(whitening.transpose(), 1e-12));
   EXPECT_TRUE((whitening.topRightCorner<3, 3>().isZero(0)));
   EXPECT_TRUE((whitening.bottomLeftCorner<3, 3>().isZero(0)));
@@ -261,56 +270,270 @@ TEST(FramesetMotion, TranslationPriorWhiteningOverThePosedFramesets) {
     on_polynomial.push_back(
         Eigen::Map<const TranslationDerivatives>(&motion[9]));
   }
-  EXPECT_TRUE(TranslationPriorWhitening(motions, on_polynomial, poses)
-                  .isApprox(expected / 0.01, 1e-12));
+  EXPECT_TRUE(EstimateTranslationPrior(motions, on_polynomial, poses)
+                  .whitening.isApprox(expected / 0.01, 1e-12));
   // At rest, or no pose: the identity.
-  EXPECT_EQ(TranslationPriorWhitening(std::vector<FramesetMotion>(4), {},
-                                      poses),
+  EXPECT_EQ(EstimateTranslationPrior(std::vector<FramesetMotion>(4), {}, poses)
+                .whitening,
             (Eigen::Matrix<double, 6, 6>::Identity()));
-  EXPECT_EQ(TranslationPriorWhitening(
+  EXPECT_EQ(EstimateTranslationPrior(
                 motions, {},
-                {std::nullopt, std::nullopt, std::nullopt, std::nullopt}),
+                {std::nullopt, std::nullopt, std::nullopt, std::nullopt})
+                .whitening,
             (Eigen::Matrix<double, 6, 6>::Identity()));
+}
+
+// Framesets with p1 = (1e-3, 0, 0) and p2 = (0, 1e-3, 0), so that the
+// floors, 1e-5 per axis, are far below the deviations, and the estimates
+// [p1, p2] + deviation.
+struct Autoregression {
+  std::vector<FramesetMotion> motions;
+  std::vector<TranslationDerivatives> estimates;
+  std::vector<std::optional<Rigid3d>> poses;
+};
+
+Autoregression FromDeviations(
+    const std::vector<TranslationDerivatives>& deviations) {
+  Autoregression data;
+  data.motions.assign(deviations.size(), FramesetMotion{});
+  data.poses.assign(deviations.size(), Rigid3d());
+  for (size_t f = 0; f < deviations.size(); ++f) {
+    data.motions[f][9] = 1e-3;
+    data.motions[f][13] = 1e-3;
+    data.estimates.push_back(
+        Eigen::Map<const TranslationDerivatives>(&data.motions[f][9]) +
+        deviations[f]);
+  }
+  return data;
+}
+
+// Without innovations, exactly: three runs of 15 framesets (the frameset
+// between two runs without a pose), the velocity's deviation along x in
+// the first decaying as (-0.6)^f, along y in the second as (-0.3)^f, along
+// z in the third as 0.5^f, so that S_d is diagonal and the regression along
+// each axis exact (to the floor's bias, 4e-10 / sum d^2); the acceleration's
+// along z throughout as (-0.95)^f. Phi: -0.6 and -0.3 recovered, 0.5 cut to
+// 0, -0.95 capped at -kMaxTranslationPriorCorrelation; the innovations
+// zero on x and y (the floor), d_f itself on the velocity's z, and
+// d_f + 0.9 d_(f-1) = -0.05 d_(f-1) on the acceleration's.
+TEST(FramesetMotion, TranslationPriorAutoregressionExactWithoutInnovations) {
+  std::vector<TranslationDerivatives> deviations(47,
+                                                 TranslationDerivatives::Zero());
+  const std::array<double, 3> gains = {-0.6, -0.3, 0.5};
+  for (int run = 0; run < 3; ++run) {
+    for (int step = 0; step < 15; ++step) {
+      deviations[16 * run + step](run) = 0.8 * std::pow(gains[run], step);
+    }
+  }
+  for (int f = 0; f < 47; ++f) deviations[f](5) = 0.4 * std::pow(-0.95, f);
+  Autoregression data = FromDeviations(deviations);
+  data.poses[15] = data.poses[31] = std::nullopt;
+  const TranslationPrior prior =
+      EstimateTranslationPrior(data.motions, data.estimates, data.poses);
+  Eigen::Matrix<double, 6, 6> expected_gain =
+      Eigen::Matrix<double, 6, 6>::Zero();
+  expected_gain(0, 0) = -0.6;
+  expected_gain(1, 1) = -0.3;
+  expected_gain(5, 5) = -kMaxTranslationPriorCorrelation;
+  EXPECT_LT((prior.predecessor_gain - expected_gain).cwiseAbs().maxCoeff(),
+            1e-8)
+      << prior.predecessor_gain;
+  // The innovations' variances, over the 42 consecutive pairs.
+  double velocity_z = 0, acceleration_z = 0;
+  for (int f = 1; f < 47; ++f) {
+    if (!data.poses[f] || !data.poses[f - 1]) continue;
+    velocity_z += deviations[f](2) * deviations[f](2) / 42;
+    acceleration_z += 0.05 * deviations[f - 1](5) * 0.05 *
+                      deviations[f - 1](5) / 42;
+  }
+  Eigen::Matrix<double, 6, 1> expected_scale;
+  expected_scale << 1e-5, 1e-5, std::sqrt(velocity_z), 1e-5, 1e-5,
+      std::sqrt(acceleration_z);
+  EXPECT_TRUE(prior.innovation_whitening.isApprox(
+      Eigen::Matrix<double, 6, 6>(expected_scale.cwiseInverse().asDiagonal()),
+      1e-6))
+      << prior.innovation_whitening;
+}
+
+// Deviations d_f = Phi d_(f-1) + i_f over 2000 framesets, Phi = diag(-0.76,
+// -0.3, 0.5) on the velocity, innovations of 0.1, 0.05, 0.2 (so that the
+// principal axes are x, y, z); diag(0.3, -0.2, -0.97) on the acceleration,
+// innovations 0.1, 0.05, 0.1. Phi within its sampling error (about 1 / sqrt(2000) =
+// 0.02), the positive gains cut to 0, -0.97 capped; the innovations'
+// deviations within theirs.
+TEST(FramesetMotion, TranslationPriorAutoregressionFromNoisyDeviations) {
+  const Eigen::Array<double, 6, 1> gain =
+      (Eigen::Array<double, 6, 1>() << -0.76, -0.3, 0.5, 0.3, -0.2, -0.97)
+          .finished();
+  const Eigen::Array<double, 6, 1> scale =
+      (Eigen::Array<double, 6, 1>() << 0.1, 0.05, 0.2, 0.1, 0.05, 0.1)
+          .finished();
+  std::mt19937 random(7);
+  std::normal_distribution<double> normal;
+  std::vector<TranslationDerivatives> deviations;
+  TranslationDerivatives deviation = TranslationDerivatives::Zero();
+  for (int f = 0; f < 2000; ++f) {
+    for (int k = 0; k < 6; ++k) {
+      deviation(k) = gain(k) * deviation(k) + scale(k) * normal(random);
+    }
+    deviations.push_back(deviation);
+  }
+  const Autoregression data = FromDeviations(deviations);
+  const TranslationPrior prior =
+      EstimateTranslationPrior(data.motions, data.estimates, data.poses);
+  const Eigen::Matrix<double, 6, 6>& phi = prior.predecessor_gain;
+  EXPECT_NEAR(phi(0, 0), -0.76, 0.05);
+  EXPECT_NEAR(phi(1, 1), -0.3, 0.05);
+  EXPECT_NEAR(phi(2, 2), 0, 0.02);
+  EXPECT_NEAR(phi(3, 3), 0, 0.02);
+  EXPECT_NEAR(phi(4, 4), -0.2, 0.05);
+  EXPECT_NEAR(phi(5, 5), -kMaxTranslationPriorCorrelation, 0.01);
+  EXPECT_TRUE((phi.topRightCorner<3, 3>().isZero(0)));
+  EXPECT_TRUE((phi.bottomLeftCorner<3, 3>().isZero(0)));
+  EXPECT_LT(std::abs(phi(0, 1)) + std::abs(phi(0, 2)) + std::abs(phi(1, 2)),
+            0.05);
+  // The innovations: the drawn ones where the gain is kept, d_f itself on
+  // the velocity's z (its stationary deviation 0.2 / sqrt(1 - 0.25) =
+  // 0.231), d_f + 0.9 d_(f-1) = -0.07 d_(f-1) + i_f on the acceleration's
+  // z (sqrt(0.01 + 0.07^2 0.01 / (1 - 0.97^2)) = 0.104).
+  const Eigen::Matrix<double, 6, 6> covariance =
+      (prior.innovation_whitening * prior.innovation_whitening).inverse();
+  EXPECT_NEAR(std::sqrt(covariance(0, 0)), 0.1, 0.006);
+  EXPECT_NEAR(std::sqrt(covariance(1, 1)), 0.05, 0.003);
+  EXPECT_NEAR(std::sqrt(covariance(2, 2)), 0.231, 0.015);
+  EXPECT_NEAR(std::sqrt(covariance(5, 5)), 0.104, 0.006);
+  // The deviations' own: the alternating axis's stationary deviation,
+  // 0.1 / sqrt(1 - 0.76^2) = 0.154.
+  const Eigen::Matrix<double, 6, 6> deviation_covariance =
+      (prior.whitening * prior.whitening).inverse();
+  EXPECT_NEAR(std::sqrt(deviation_covariance(0, 0)), 0.154, 0.015);
 }
 
 TEST(TranslationPriorCost, ResidualAndJacobianPerRowPair) {
   FramesetMotion motion{};
   for (int k = 0; k < 6; ++k) motion[9 + k] = 0.5 * k - 1;  // [p1, p2]
-  // r = W (e - [p1, p2]): rows 0-1, 2-3 and 4-5 in the three costs.
-  Eigen::Matrix<double, 6, 6> whitening;
+  // r = W_d (e - [p1, p2]): rows 0-1, 2-3 and 4-5 in the three costs.
+  TranslationPrior prior;
   for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) whitening(i, j) = i == j ? 2 : 0.1 * (i + j);
+    for (int j = 0; j < 6; ++j) {
+      prior.whitening(i, j) = i == j ? 2 : 0.1 * (i + j);
+    }
   }
+  prior.innovation_whitening.setConstant(100);  // not read
   double estimate[6];
   for (int k = 0; k < 6; ++k) estimate[k] = motion[9 + k] + 0.1 * (k + 1);
   const Eigen::Matrix<double, 6, 1> deviation =
       Eigen::Matrix<double, 6, 1>::LinSpaced(6, 0.1, 0.6);
-  const Eigen::Matrix<double, 6, 1> expected = whitening * deviation;
+  const Eigen::Matrix<double, 6, 1> expected = prior.whitening * deviation;
   const double* parameters[] = {estimate};
   for (const int first_row : {0, 2, 4}) {
     SCOPED_TRACE(first_row);
-    const TranslationPriorCost cost(&motion, &whitening, first_row);
+    const TranslationPriorCost cost(&motion, &prior, first_row);
     double residuals[2], jacobian[12];
     double* jacobians[] = {jacobian};
     ASSERT_TRUE(cost.Evaluate(parameters, residuals, jacobians));
     for (int row = 0; row < 2; ++row) {
       EXPECT_NEAR(residuals[row], expected(first_row + row), 1e-14);
       for (int k = 0; k < 6; ++k) {
-        EXPECT_EQ(jacobian[6 * row + k], whitening(first_row + row, k));
+        EXPECT_EQ(jacobian[6 * row + k], prior.whitening(first_row + row, k));
       }
     }
   }
   // p1, p2 and W are read at every evaluation.
-  const TranslationPriorCost last(&motion, &whitening, 4);
+  const TranslationPriorCost last(&motion, &prior, 4);
   for (int k = 0; k < 6; ++k) motion[9 + k] = estimate[k];
   double residuals[2];
   ASSERT_TRUE(last.Evaluate(parameters, residuals, nullptr));
   EXPECT_EQ(residuals[0], 0.0);
   for (int k = 0; k < 6; ++k) motion[9 + k] = estimate[k] - 1;
-  whitening.setIdentity();
+  prior.whitening.setIdentity();
   ASSERT_TRUE(last.Evaluate(parameters, residuals, nullptr));
   EXPECT_NEAR(residuals[0], 1, 1e-15);
   EXPECT_NEAR(residuals[1], 1, 1e-15);
+}
+
+// r = W_i (d_f - Phi d_(f-1)) for d = e - [p1, p2] of each frameset, with
+// Jacobians W_i and -W_i Phi, against the formula and central differences;
+// the prior read at every evaluation.
+TEST(TranslationInnovationCost, ResidualAndJacobiansPerRowPair) {
+  FramesetMotion motion{}, previous_motion{};
+  for (int k = 0; k < 6; ++k) {
+    motion[9 + k] = 0.5 * k - 1;
+    previous_motion[9 + k] = 0.3 - 0.2 * k;
+  }
+  TranslationPrior prior;
+  prior.whitening.setConstant(100);  // not read
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      prior.innovation_whitening(i, j) = i == j ? 3 : 0.05 * (i - 2 * j);
+      prior.predecessor_gain(i, j) = i == j ? -0.6 : 0.02 * (i + j);
+    }
+  }
+  double estimate[6], previous_estimate[6];
+  for (int k = 0; k < 6; ++k) {
+    estimate[k] = motion[9 + k] + 0.1 * (k + 1);
+    previous_estimate[k] = previous_motion[9 + k] - 0.05 * k;
+  }
+  const Eigen::Matrix<double, 6, 1> deviation =
+      Eigen::Matrix<double, 6, 1>::LinSpaced(6, 0.1, 0.6);
+  const Eigen::Matrix<double, 6, 1> previous_deviation =
+      Eigen::Matrix<double, 6, 1>::LinSpaced(6, 0, -0.25);
+  const Eigen::Matrix<double, 6, 1> expected =
+      prior.innovation_whitening *
+      (deviation - prior.predecessor_gain * previous_deviation);
+  const Eigen::Matrix<double, 6, 6> expected_previous_jacobian =
+      -prior.innovation_whitening * prior.predecessor_gain;
+  for (const int first_row : {0, 2, 4}) {
+    SCOPED_TRACE(first_row);
+    const TranslationInnovationCost cost(&motion, &previous_motion, &prior,
+                                         first_row);
+    const double* parameters[] = {estimate, previous_estimate};
+    double residuals[2], jacobian[12], previous_jacobian[12];
+    double* jacobians[] = {jacobian, previous_jacobian};
+    ASSERT_TRUE(cost.Evaluate(parameters, residuals, jacobians));
+    for (int row = 0; row < 2; ++row) {
+      EXPECT_NEAR(residuals[row], expected(first_row + row), 1e-14);
+      for (int k = 0; k < 6; ++k) {
+        EXPECT_NEAR(jacobian[6 * row + k],
+                    prior.innovation_whitening(first_row + row, k), 1e-15);
+        EXPECT_NEAR(previous_jacobian[6 * row + k],
+                    expected_previous_jacobian(first_row + row, k), 1e-15);
+      }
+    }
+    // Central differences (exact for a linear residual up to rounding).
+    for (int block = 0; block < 2; ++block) {
+      for (int k = 0; k < 6; ++k) {
+        double plus[6], minus[6];
+        const double* values = block == 0 ? estimate : previous_estimate;
+        std::copy(values, values + 6, plus);
+        std::copy(values, values + 6, minus);
+        plus[k] += 1e-4;
+        minus[k] -= 1e-4;
+        double r_plus[2], r_minus[2];
+        const double* at_plus[] = {block == 0 ? plus : estimate,
+                                   block == 1 ? plus : previous_estimate};
+        const double* at_minus[] = {block == 0 ? minus : estimate,
+                                    block == 1 ? minus : previous_estimate};
+        ASSERT_TRUE(cost.Evaluate(at_plus, r_plus, nullptr));
+        ASSERT_TRUE(cost.Evaluate(at_minus, r_minus, nullptr));
+        for (int row = 0; row < 2; ++row) {
+          EXPECT_NEAR((r_plus[row] - r_minus[row]) / 2e-4,
+                      (block == 0 ? jacobian : previous_jacobian)[6 * row + k],
+                      1e-9);
+        }
+      }
+    }
+  }
+  // No gain: the frameset's own deviation alone, whitened by W_i.
+  prior.predecessor_gain.setZero();
+  const TranslationInnovationCost first(&motion, &previous_motion, &prior, 0);
+  const double* parameters[] = {estimate, previous_estimate};
+  double residuals[2];
+  ASSERT_TRUE(first.Evaluate(parameters, residuals, nullptr));
+  const Eigen::Matrix<double, 6, 1> own =
+      prior.innovation_whitening * deviation;
+  EXPECT_NEAR(residuals[0], own(0), 1e-14);
+  EXPECT_NEAR(residuals[1], own(1), 1e-14);
 }
 
 }  // namespace frameset_motion_test
