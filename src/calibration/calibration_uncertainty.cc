@@ -666,24 +666,14 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
        ++f) {
     if (rig_pose_block_[f] < 0) continue;
     // As the adjustment's (RigAdjustment::AddTranslationPriors).
-    const bool after_previous = f > 0 && rig_pose_block_[f - 1] >= 0;
-    for (const int first_row : {0, 2, 4}) {
-      std::vector<double*> blocks = {translations_[f].data()};
-      if (after_previous) {
-        translation_prior_costs_.push_back(
-            std::make_unique<TranslationInnovationCost>(
-                &frameset_motions_[f], &frameset_motions_[f - 1],
-                &translation_prior_, first_row));
-        blocks.push_back(translations_[f - 1].data());
-      } else {
-        translation_prior_costs_.push_back(
-            std::make_unique<TranslationPriorCost>(
-                &frameset_motions_[f], &translation_prior_, first_row));
-      }
+    for (TranslationPriorTerm& term : MakeTranslationPriorTerms(
+             frameset_motions_, &translations_, f,
+             f > 0 && rig_pose_block_[f - 1] >= 0, &translation_prior_)) {
+      translation_prior_costs_.push_back(std::move(term.cost));
       translation_priors_.emplace_back(
           static_cast<int>(f),
           solver_->AddResidualBlock(translation_prior_costs_.back().get(),
-                                    nullptr, blocks));
+                                    nullptr, term.parameters));
     }
   }
   if (!solver_->LinearizeGaussNewton(error)) return false;

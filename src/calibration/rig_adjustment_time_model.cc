@@ -56,22 +56,12 @@ void RigAdjustment::AddTranslationPriors(
     const std::vector<char>& frameset_refined) {
   for (size_t f = 0; f < frameset_refined.size(); ++f) {
     if (!frameset_refined[f]) continue;
-    const bool after_previous = f > 0 && frameset_refined[f - 1];
-    for (const int first_row : {0, 2, 4}) {
-      std::vector<double*> blocks = {frameset_translations_[f].data()};
-      if (after_previous) {
-        translation_prior_costs_.push_back(
-            std::make_unique<TranslationInnovationCost>(
-                &frameset_motions_[f], &frameset_motions_[f - 1],
-                &translation_prior_, first_row));
-        blocks.push_back(frameset_translations_[f - 1].data());
-      } else {
-        translation_prior_costs_.push_back(
-            std::make_unique<TranslationPriorCost>(
-                &frameset_motions_[f], &translation_prior_, first_row));
-      }
+    for (TranslationPriorTerm& term : MakeTranslationPriorTerms(
+             frameset_motions_, &frameset_translations_, f,
+             f > 0 && frameset_refined[f - 1], &translation_prior_)) {
+      translation_prior_costs_.push_back(std::move(term.cost));
       solver_->AddResidualBlock(translation_prior_costs_.back().get(), nullptr,
-                                blocks);
+                                term.parameters);
     }
   }
 }

@@ -24,6 +24,8 @@
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
+#include <memory>
+#include <vector>
 
 #include "src/geometry/frameset_motion.h"
 
@@ -100,5 +102,35 @@ class TranslationInnovationCost final
   const TranslationPrior* prior_;
   const int first_row_;
 };
+
+// Frameset f's prior: its three costs (first_row 0, 2, 4) with their
+// parameter blocks, a TranslationInnovationCost where the previous frameset
+// is in the problem too (`after_previous`), else a TranslationPriorCost.
+// `motions` and `estimates` per frameset, read by pointer (see above).
+struct TranslationPriorTerm {
+  std::unique_ptr<ceres::CostFunction> cost;
+  std::vector<double*> parameters;
+};
+
+inline std::vector<TranslationPriorTerm> MakeTranslationPriorTerms(
+    const std::vector<FramesetMotion>& motions,
+    std::vector<TranslationDerivatives>* estimates, size_t f,
+    bool after_previous, const TranslationPrior* prior) {
+  std::vector<TranslationPriorTerm> terms;
+  for (const int first_row : {0, 2, 4}) {
+    TranslationPriorTerm term;
+    term.parameters.push_back((*estimates)[f].data());
+    if (after_previous) {
+      term.cost = std::make_unique<TranslationInnovationCost>(
+          &motions[f], &motions[f - 1], prior, first_row);
+      term.parameters.push_back((*estimates)[f - 1].data());
+    } else {
+      term.cost =
+          std::make_unique<TranslationPriorCost>(&motions[f], prior, first_row);
+    }
+    terms.push_back(std::move(term));
+  }
+  return terms;
+}
 
 }  // namespace rig_calibrator
