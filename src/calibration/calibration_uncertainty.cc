@@ -235,9 +235,11 @@ class UncertaintyProblem {
   // The time model (final_bundle_adjuster.h), empty without: per rig camera
   // its offset and line delay (the options' values: the result's), per
   // frameset the rig's motion around it from the result's rig poses, held
-  // as in the adjustment.
+  // as in the adjustment, and its velocity's and acceleration's weights on
+  // the poses (the prior's polynomial, a function of the poses here too).
   std::vector<double> time_offsets_, line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
+  std::vector<TranslationStencil> translation_stencils_;
   // Per frameset the estimated velocity and acceleration (the result's,
   // else the motion's p1 and p2), a parameter in its rig pose's block, with
   // its prior as in the adjustment: the autoregression, the costs, and per
@@ -322,7 +324,8 @@ bool UncertaintyProblem::SetUpTimeModel(std::string* error) {
   if (!ComputeFramesetMotions(dataset_.frameset_times_s,
                               calibration_.rig_from_world, &frameset_motions_,
                               error,
-                              calibration_.frameset_motions_without_own_pose)) {
+                              calibration_.frameset_motions_without_own_pose,
+                              &translation_stencils_)) {
     *error = "the time model's frameset motions: " + *error;
     return false;
   }
@@ -662,12 +665,18 @@ bool UncertaintyProblem::BuildReducedSystem(std::string* error) {
     observation.residual = solver_->AddResidualBlock(
         residual_costs_[k].get(), nullptr, parameters);
   }
+  std::vector<double*> rig_poses(rig_from_world_.size(), nullptr);
+  for (size_t f = 0; f < rig_poses.size(); ++f) {
+    if (calibration_.rig_from_world[f]) {
+      rig_poses[f] = rig_from_world_[f].data();
+    }
+  }
   for (size_t f = 0; f < rig_pose_block_.size() && !frameset_motions_.empty();
        ++f) {
     if (rig_pose_block_[f] < 0) continue;
     // As the adjustment's (RigAdjustment::AddTranslationPriors).
     for (TranslationPriorTerm& term : MakeTranslationPriorTerms(
-             frameset_motions_, &translations_, f,
+             translation_stencils_, rig_poses, &translations_, f,
              f > 0 && rig_pose_block_[f - 1] >= 0, &translation_prior_)) {
       translation_prior_costs_.push_back(std::move(term.cost));
       translation_priors_.emplace_back(

@@ -22,10 +22,10 @@
 // held within a solve and recomputed before each (the cost:
 // timed_rig_reprojection_cost.h), except the translational velocity and
 // acceleration [v_f, a_f]: parameters of each frameset, in its pose's block
-// row, with a prior towards the polynomial's (translation_prior_cost.h),
-// because the images see them and the frameset poses do not follow a
-// motion faster than a fraction of their rate (a walk's bob at 5 Hz, a
-// car's vibration at 15 Hz).
+// row, with a prior towards the polynomial's, evaluated from the poses
+// inside the solve (translation_prior_cost.h), because the images see them
+// and the frameset poses do not follow a motion faster than a fraction of
+// their rate (a walk's bob at 5 Hz, a car's vibration at 15 Hz).
 // delta_c are refined for the non-reference
 // cameras (delta_ref = 0 defines the rig's clock), rho_c for every camera
 // (a rolling shutter's line delay is observable for the reference camera

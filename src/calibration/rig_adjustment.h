@@ -185,14 +185,16 @@ class RigAdjustment {
   std::vector<PoseParams> rig_from_world_;
   std::vector<bool> has_rig_pose_;
   // The time model (empty without): per camera its offset and line delay,
-  // per frameset its motion from the poses (sized once: the costs point
-  // into it), whether that motion leaves the frameset's own pose out, and
+  // per frameset its motion from the poses and its velocity's and
+  // acceleration's weights on them (sized once: the costs point into
+  // them), whether that motion leaves the frameset's own pose out, and
   // its estimated translational velocity and acceleration, which replace
   // the motion's p1 and p2 (frameset_motion.h); their prior's whitening and
   // costs.
   std::vector<double> time_offsets_;
   std::vector<double> line_delays_;
   std::vector<FramesetMotion> frameset_motions_;
+  std::vector<TranslationStencil> translation_stencils_;
   std::vector<char> frameset_without_own_pose_;
   std::vector<TranslationDerivatives> frameset_translations_;
   bool translations_started_ = false;

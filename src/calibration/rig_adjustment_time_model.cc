@@ -35,7 +35,8 @@ void RigAdjustment::UpdateFramesetMotions() {
   std::vector<FramesetMotion> motions;
   std::string error;
   CHECK(ComputeFramesetMotions(dataset_.frameset_times_s, poses, &motions,
-                               &error, frameset_without_own_pose_))
+                               &error, frameset_without_own_pose_,
+                               &translation_stencils_))
       << error << " (checked by AdjustRig)";
   std::copy(motions.begin(), motions.end(), frameset_motions_.begin());
   translation_prior_ = EstimateTranslationPrior(
@@ -54,10 +55,14 @@ void RigAdjustment::UpdateFramesetMotions() {
 
 void RigAdjustment::AddTranslationPriors(
     const std::vector<char>& frameset_refined) {
+  std::vector<double*> rig_poses(rig_from_world_.size(), nullptr);
+  for (size_t f = 0; f < rig_poses.size(); ++f) {
+    if (has_rig_pose_[f]) rig_poses[f] = rig_from_world_[f].data();
+  }
   for (size_t f = 0; f < frameset_refined.size(); ++f) {
     if (!frameset_refined[f]) continue;
     for (TranslationPriorTerm& term : MakeTranslationPriorTerms(
-             frameset_motions_, &frameset_translations_, f,
+             translation_stencils_, rig_poses, &frameset_translations_, f,
              f > 0 && frameset_refined[f - 1], &translation_prior_)) {
       translation_prior_costs_.push_back(std::move(term.cost));
       solver_->AddResidualBlock(translation_prior_costs_.back().get(), nullptr,

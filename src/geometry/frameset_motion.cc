@@ -81,7 +81,8 @@ bool ComputeFramesetMotions(
     const std::vector<double>& times_s,
     const std::vector<std::optional<Rigid3d>>& rig_from_world,
     std::vector<FramesetMotion>* motions, std::string* error,
-    const std::vector<char>& without_own_pose) {
+    const std::vector<char>& without_own_pose,
+    std::vector<TranslationStencil>* stencils) {
   if (times_s.size() != rig_from_world.size()) {
     *error = "frameset motion: " + std::to_string(times_s.size()) +
              " frameset times for " + std::to_string(rig_from_world.size()) +
@@ -101,11 +102,19 @@ bool ComputeFramesetMotions(
     return false;
   }
   motions->assign(times_s.size(), FramesetMotion{});
+  if (stencils != nullptr) {
+    stencils->resize(times_s.size());
+    for (TranslationStencil& stencil : *stencils) {
+      stencil.window.clear();
+      stencil.own_slot = -1;
+    }
+  }
   for (size_t i = 0; i < posed.size(); ++i) {
     const int frameset = posed[i];
+    const bool own_left_out =
+        !without_own_pose.empty() && without_own_pose[frameset];
     const std::vector<int> knots =
-        Knots(posed, static_cast<int>(i),
-              !without_own_pose.empty() && without_own_pose[frameset]);
+        Knots(posed, static_cast<int>(i), own_left_out);
     const Rigid3d world_from_rig = rig_from_world[frameset]->Inverse();
     const Eigen::Matrix3d rotation_t =
         world_from_rig.RotationMatrix().transpose();
@@ -113,6 +122,21 @@ bool ComputeFramesetMotions(
     for (const int knot : knots) nodes.push_back(times_s[knot]);
     const Eigen::Matrix<double, 3, Eigen::Dynamic> weights =
         DerivativeWeights(nodes, times_s[frameset]);
+    if (stencils != nullptr) {
+      TranslationStencil& stencil = (*stencils)[frameset];
+      stencil.window = Knots(posed, static_cast<int>(i), false);
+      stencil.own_slot = static_cast<int>(
+          std::find(stencil.window.begin(), stencil.window.end(), frameset) -
+          stencil.window.begin());
+      stencil.weights.setZero(2, static_cast<int>(stencil.window.size()));
+      for (size_t j = 0; j < knots.size(); ++j) {
+        const int slot = static_cast<int>(
+            std::find(stencil.window.begin(), stencil.window.end(),
+                      knots[j]) -
+            stencil.window.begin());
+        stencil.weights.col(slot) = weights.col(j).head<2>();
+      }
+    }
     FramesetMotion& motion = (*motions)[frameset];
     for (size_t j = 0; j < knots.size(); ++j) {
       const Rigid3d knot = rig_from_world[knots[j]]->Inverse();

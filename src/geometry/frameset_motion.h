@@ -23,7 +23,8 @@
 //
 // Why this form: the motion is relative to Q_f, so it follows Q_f while an
 // adjustment moves it (held fixed within a solve, recomputed from the
-// adjusted poses between solves), and each observation needs only its own
+// adjusted poses between solves; the velocity and acceleration are
+// estimated instead, below), and each observation needs only its own
 // frameset's pose, as without a time model. Why third order: the
 // truncation error is tau^4/24 |u''''|; a first-order (constant twist)
 // model errs by tau^2/2 |u2|, 0.04 deg at tau = 50 ms and 0.5 rad/s^2, twice
@@ -96,19 +97,37 @@ namespace rig_calibrator {
 // [u1, u2, u3, p1, p2, p3], 3 values each (see above).
 using FramesetMotion = std::array<double, 18>;
 
+// The polynomial's velocity and acceleration at a frameset as weights on
+// its window's positions, [p1, p2] = sum_j [w1_j; w2_j] p_j with p_j =
+// R_f^T (c_j - c_f) (above), so that the velocities' prior
+// (translation_prior_cost.h) takes them as functions of the poses inside a
+// solve. `window`: the kStencil = 5 nearest posed framesets (fewer when
+// fewer have a pose), the frameset's own among them at `own_slot`, with
+// weight zero where its motion leaves the own pose out. The window depends
+// only on which framesets have a pose, so that a cost built on it keeps its
+// parameter blocks while the weights change between solves. Empty window:
+// a frameset without a pose.
+struct TranslationStencil {
+  std::vector<int> window;
+  int own_slot = -1;
+  Eigen::Matrix<double, 2, Eigen::Dynamic> weights;  // 2 x window size
+};
+
 // Per frameset the motion above from the rig poses of the framesets that
 // have one (rig_from_world, one entry per frameset) at `times_s` (one per
 // frameset, strictly increasing); zero motion for framesets without a pose.
 // `without_own_pose` (per frameset, or empty: none) marks the framesets
 // whose motion leaves their own pose out (see above; with fewer than three
-// posed framesets it is kept). False with `error` when sizes differ or
-// fewer than two framesets have a pose.
-bool ComputeFramesetMotions(const std::vector<double>& times_s,
-                            const std::vector<std::optional<Rigid3d>>&
-                                rig_from_world,
-                            std::vector<FramesetMotion>* motions,
-                            std::string* error,
-                            const std::vector<char>& without_own_pose = {});
+// posed framesets it is kept). `stencils` (optional): per frameset the
+// weights of its p1 and p2, written element by element (the costs point
+// into them). False with `error` when sizes differ or fewer than two
+// framesets have a pose.
+bool ComputeFramesetMotions(
+    const std::vector<double>& times_s,
+    const std::vector<std::optional<Rigid3d>>& rig_from_world,
+    std::vector<FramesetMotion>* motions, std::string* error,
+    const std::vector<char>& without_own_pose = {},
+    std::vector<TranslationStencil>* stencils = nullptr);
 
 // The own pose's gain above beyond which a frameset's motion leaves it out:
 // the alternation then shrinks the pose's error at least by half per solve

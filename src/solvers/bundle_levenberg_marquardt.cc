@@ -27,8 +27,10 @@ namespace {
 constexpr int kMaxNumChunks = 16;
 // A residual's blocks: a pose, a cam_from_rig, intrinsics, with the final
 // adjustment's time model a capture-time offset, a line delay and the
-// frameset's velocity, and a point.
-constexpr int kMaxParametersPerResidual = 7;
+// frameset's velocity, and a point; the time model's velocity prior takes
+// the most, two framesets' velocities and the six poses of their windows
+// (translation_prior_cost.h).
+constexpr int kMaxParametersPerResidual = 8;
 // Ceres' defaults (LevenbergMarquardtStrategy, TrustRegionMinimizer).
 constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;

@@ -7,8 +7,9 @@
 // (analytic Jacobians: rig_reprojection_cost.h; automatic ones for the time
 // model's timed_rig_reprojection_cost.h) over up to five "camera side"
 // parameter blocks (a pose, a cam_from_rig, intrinsics, and with the final
-// adjustment's time model a capture-time offset and a line delay) and at
-// most one point (3 values), with a robust loss rho:
+// adjustment's time model a capture-time offset and a line delay; its
+// velocities' prior, translation_prior_cost.h, up to eight) and at most one
+// point (3 values), with a robust loss rho:
 //
 //   min_x  F(x) = 1/2 sum_t rho(|r_t(x)|^2).
 //
