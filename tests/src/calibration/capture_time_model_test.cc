@@ -458,8 +458,9 @@ TEST(CaptureTimeModel, DefaultMethodAndAutomaticModelsFromScratch) {
 // lens, and the points cam2 sees are refined through it. The choice on the
 // adjusted rig takes each point as the other images place it
 // (points_without_camera.h): every camera gets OPENCV, and the rig is within
-// 0.03 deg and 0.8 mm (measured 0.022 deg, 0.69 mm; one draw: over 5 other
-// seeds the ring's centre error at 5 Hz is 0.27 mm RMS; 0.34 mm with the
+// 0.03 deg and 0.8 mm (measured 0.022 deg, 0.67 mm; one draw: over 5 other
+// seeds the ring's centre error at 5 Hz is 0.33 mm RMS, 0.27 mm with the
+// prior's polynomial held within each solve; 0.34 mm with the
 // frameset velocities' deviations taken as independent, which measured
 // 0.83 mm on this draw; 0.39 mm with only the velocities estimated). With the
 // refined points everywhere cam2 got OPENCV_FISHEYE and the rig was 0.19
@@ -494,9 +495,10 @@ TEST(CaptureTimeModel, DefaultPathAt5HzAnd1080RowsChoosesTheTrueModels) {
 // reference camera's image) ran 1.6 m off, its rig pose left the
 // uncertainty undetermined, auto kept nothing and the rig was 1.6 deg off
 // (frameset_motion.h). Now offsets within 0.5 ms, line delays within 5 %,
-// the rig within 0.03 deg and 1.2 mm (measured 0.0231 deg, 0.79 mm; one
+// the rig within 0.03 deg and 1.2 mm (measured 0.0231 deg, 0.81 mm; one
 // draw: over 8 other seeds the helmet's rotation error at 15 Hz is
-// 0.0094 deg RMS against 0.0091 deg synchronized, docs/time_model.md).
+// 0.0109 deg RMS against 0.0091 deg synchronized, its centre error
+// 0.313 mm against 0.293 mm, docs/time_model.md).
 // With only the velocities estimated, not the accelerations, this draw
 // measured 0.0129 deg, 0.90 mm, and the 8 seeds 0.0097 deg.
 TEST(CaptureTimeModel, DefaultPathAt15HzWithOffsetsNearTheFramesetInterval) {
