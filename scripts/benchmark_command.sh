@@ -17,6 +17,7 @@
 #   RIG_CALIBRATOR_BUILD_DIR  build folder (default: build/)
 #   BENCHMARK_CAMERAS         cameras on the ring (default 10)
 #   BENCHMARK_THREADS         --RigCalibrator.num_threads (default -1: all)
+#   BENCHMARK_SEED            the synthetic data's --seed (default 0)
 #   BENCHMARK_TIME_MODEL      1: the rig is unsynchronized with rolling
 #                             shutters (framesets at 15 Hz, the rig at
 #                             1.5 m/s and 60 deg/s, offsets in +-50 ms, line
@@ -40,6 +41,7 @@ sizes=("$@")
 [[ ${#sizes[@]} -gt 0 ]] || sizes=(500)
 cameras="${BENCHMARK_CAMERAS:-10}"
 threads="${BENCHMARK_THREADS:--1}"
+seed="${BENCHMARK_SEED:-0}"
 time_model="${BENCHMARK_TIME_MODEL:-0}"
 runs=(defaults true_models)
 timed_data=()
@@ -85,7 +87,8 @@ for framesets in "${sizes[@]}"; do
     --ring_num_cameras "$cameras" --num_framesets "$framesets" \
     --points_per_image 300 --outlier_ratio 0.3 --missing_image_ratio 0.1 \
     --num_map_images 60 --map_observations_per_image 3000 \
-    --map_noise_px 0.5 --map_point_noise 0.005 "${timed_data[@]}" \
+    --map_noise_px 0.5 --map_point_noise 0.005 --seed "$seed" \
+    "${timed_data[@]}" \
     >"$case_dir/synthetic.log" ||
     die "generating the data failed; see $case_dir/synthetic.log"
   true_models="$(sed -n 's/.*--RigCalibrator.camera_model \([^ ]*\).*/\1/p' \
@@ -111,6 +114,7 @@ done
 import json, math, os, re, sys
 
 results, cameras = sys.argv[1], int(sys.argv[2])
+seed = os.environ.get("BENCHMARK_SEED", "0")
 runs, sizes = sys.argv[3].split(), [int(s) for s in sys.argv[4:]]
 
 def time_report(path):
@@ -134,8 +138,9 @@ def worst(errors_path):
             if cams and key in cams[0]}
 
 out = ["# The calibrate command with its defaults", "",
-       "Measured by `" + ("BENCHMARK_TIME_MODEL=1 " if "time_model_off" in runs
-                          else "") + "bash scripts/benchmark_command.sh RESULTS " +
+       "Measured by `" + ("BENCHMARK_SEED=%s " % seed if seed != "0" else "") +
+       ("BENCHMARK_TIME_MODEL=1 " if "time_model_off" in runs
+        else "") + "bash scripts/benchmark_command.sh RESULTS " +
        " ".join(map(str, sizes)) + "` (" + str(os.cpu_count()) +
        " cores). The defaults: camera models `auto`, refine_map, the "
        "uncertainty; wall and CPU (user + system) of the whole command, "

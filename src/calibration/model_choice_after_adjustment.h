@@ -98,6 +98,11 @@ struct AdjustedCameraRows {
 // reason in choice->reason) when fewer than two framesets, no candidate
 // valid over the image, or not the current model could be compared (a
 // change is only made against the current model's own held-out error).
+// Except: a current model that is not valid over the image when fitted on
+// the rows (kept, it would end the calibration with an error) is replaced
+// by the chosen valid candidate when that candidate's held-out error is as
+// good, by the choice rule, as the current model's training error; else
+// false.
 bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
                               const AdjustedCameraRows& rows,
                               colmap::Camera* camera, Rigid3d* cam_from_rig,

@@ -549,6 +549,20 @@ PairedDifference ComparePaired(const std::vector<double>& a,
 
 }  // namespace
 
+bool AsGoodAs(double significance, const std::vector<double>& a,
+              const std::vector<double>& b, const std::vector<int>& clusters,
+              std::string* comparison) {
+  const PairedDifference difference = ComparePaired(a, b, clusters);
+  if (comparison) {
+    *comparison = "mean squared error " +
+                  std::string(difference.mean < 0 ? "" : "+") +
+                  Fixed(difference.mean, 5) + " px^2, standard error " +
+                  Fixed(difference.standard_error, 5);
+  }
+  return difference.mean <=
+         significance * difference.standard_error + kMinMseDifference;
+}
+
 int ChooseByHeldOutError(double significance,
                          const std::vector<std::vector<double>>& squared_errors,
                          const std::vector<int>& clusters,
@@ -566,19 +580,14 @@ int ChooseByHeldOutError(double significance,
   int chosen = best;
   for (size_t m = 0; m < num_candidates; ++m) {
     if (squared_errors[m].empty()) continue;
-    const PairedDifference difference =
-        ComparePaired(squared_errors[m], squared_errors[best], clusters);
-    const double mean_difference = difference.mean;
-    const double standard_error = difference.standard_error;
-    const bool as_good =
-        mean_difference <= significance * standard_error + kMinMseDifference;
+    std::string comparison;
+    const bool as_good = AsGoodAs(significance, squared_errors[m],
+                                  squared_errors[best], clusters, &comparison);
     ModelCandidate& candidate = choice->candidates[m];
     candidate.as_good_as_best = as_good;
     if (static_cast<int>(m) != best) {
       candidate.note = std::string(as_good ? "as good as" : "worse than") +
-                       " the best (mean squared error +" +
-                       Fixed(mean_difference, 5) + " px^2, standard error " +
-                       Fixed(standard_error, 5) + ")";
+                       " the best (" + comparison + ")";
     }
     // Fewest parameters; on a tie the earlier candidate (candidates come
     // pinhole-type first: a lens they fit as well needs no fisheye model).

@@ -137,6 +137,15 @@ int ChooseByHeldOutError(double significance,
                          const std::vector<int>& clusters,
                          const std::string& evaluation, ModelChoice* choice);
 
+// Whether errors `a` are as good as `b` by the choice rule above (per
+// evaluation row, squared; d = a - b, the standard error clustered as
+// ChooseByHeldOutError's): mean(d) <= significance SE(d) +
+// kMinMseDifference. `comparison` (optional): "mean squared error +X px^2,
+// standard error Y".
+bool AsGoodAs(double significance, const std::vector<double>& a,
+              const std::vector<double>& b, const std::vector<int>& clusters,
+              std::string* comparison = nullptr);
+
 // The held-out squared errors (per evaluation row, as ChooseByHeldOutError
 // takes them) of the candidates that can still be as good as the best, the
 // others' left empty: held_out(m) computes candidate m's (its folds: most of
