@@ -201,13 +201,16 @@ void ExpectNoChoice(const colmap::Camera& truth, const std::string& start_model,
 }
 
 // A lens beyond 90 degrees at the corners, which no COLMAP model can
-// represent: no candidate is compared with the current model, nothing
-// changes.
+// represent: the current model folds inside the image, and the valid
+// candidates (a pinhole wins among them) do not fit the data as well as it
+// does, so nothing changes and its error stands.
 TEST(ModelChoiceAfterAdjustment, NoChangeWhenTheCurrentModelIsNotValid) {
   const colmap::Camera truth = MakeCamera(
       "OPENCV_FISHEYE", 800, 800, {280, 280, 400, 400, 0.05, -0.01, 0.002, 0});
   ExpectNoChoice(truth, "RADIAL_FISHEYE", MakeRows(truth, 20, 150, 0.5, 0.1, 7),
-                 "RADIAL_FISHEYE, was not valid");
+                 "RADIAL_FISHEYE, was not valid over the whole image when "
+                 "fitted on the adjusted rig, and no valid candidate fits the "
+                 "data as well");
 }
 
 // The synthetic ring's lens (an OPENCV lens at 640 x 480 with strong
