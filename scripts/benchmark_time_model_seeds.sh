@@ -12,10 +12,14 @@
 # non-reference camera of every seed: the RMS of the rotation error and of
 # the centre error per rig axis, the RMS of error / sigma (sigma the
 # summary's: 1 when sigma is honest), its largest value, and (d) against
-# (a).
+# (a), of the errors and of the sigmas (RMS; how precise the data make each
+# case); over every camera (the reference camera's intrinsics are estimated
+# too) the same for the focal length (fx, in %), the principal point (px)
+# and the largest projection difference from the true model over the image
+# (`rig_calibrator evaluate`).
 #
 # Usage: scripts/benchmark_time_model_seeds.sh RESULTS_DIR [FRAMESETS]
-#   RESULTS_DIR  created if needed; gets time_model_seeds.md (the table),
+#   RESULTS_DIR  created if needed; gets time_model_seeds.md (the tables),
 #                and per preset, case and seed the data, output and log
 #   FRAMESETS    framesets per data set (default 60)
 # Environment:
@@ -59,6 +63,10 @@ run_one() {
     --output_path "$dir/out" --RigCalibrator.timestamp_tolerance 0.5 \
     --RigCalibrator.timestamp_unit_s "$unit_s" >"$dir/calibration.log" 2>&1 ||
     touch "$dir/calibration.failed"
+  [[ -e $dir/calibration.failed ]] ||
+    "$rig_calibrator" evaluate --reference_path "$dir/data/ground_truth/camchain.yaml" \
+      --calibration_path "$dir/out" --output_path "$dir/errors.json" >/dev/null ||
+    { echo "evaluating $dir failed" >&2; return 1; }
   echo "[$log_tag] $preset ($case_name) seed $seed done"
 }
 export -f run_one
@@ -93,6 +101,11 @@ def angle_deg(q, p):  # the angle of q p^-1
     norm = math.sqrt(sum(c * c for c in q) * sum(c * c for c in p))
     return math.degrees(2 * math.acos(min(1.0, abs(w) / norm)))
 
+def pp_index(model):
+    one_focal = ("SIMPLE_PINHOLE", "SIMPLE_RADIAL", "RADIAL", "SIMPLE_RADIAL_FISHEYE",
+                 "RADIAL_FISHEYE")
+    return 1 if model in one_focal else 2
+
 def rms(values):
     return math.sqrt(sum(v * v for v in values) / len(values)) if values else float("nan")
 
@@ -101,6 +114,8 @@ failed = []
 for preset in presets:
     for case in ("a", "d"):
         rot, rot_z, axes, axes_z = [], [], [[], [], []], []
+        rot_sigma, axes_sigma = [], [[], [], []]
+        focal, focal_z, pp, pp_z, projection, other_model = [], [], [], [], [], 0
         for folder in sorted(glob.glob(os.path.join(results, f"{preset}_{case}_*"))):
             if os.path.exists(os.path.join(folder, "calibration.failed")):
                 failed.append(os.path.basename(folder))
@@ -108,6 +123,26 @@ for preset in presets:
             summary = json.load(open(os.path.join(folder, "out", "calibration_summary.json")))
             truth = json.load(open(os.path.join(folder, "data", "ground_truth",
                                                 "rig_config.json")))[0]["cameras"]
+            errors = json.load(open(os.path.join(folder, "errors.json")))["cameras"]
+            for camera, true, error in zip(summary["cameras"], truth, errors):
+                focal.append(error["focal_error_percent"])
+                pp.append(error["principal_point_error_px"])
+                projection.append(error["max_projection_diff_px"])
+                stddev = camera.get("uncertainty", {}).get("params_stddev")
+                if not stddev or not camera.get("calibrated", True):
+                    continue
+                # sigma is that of the chosen model's parameters: z only
+                # where it is the lens's (another model's focal length and
+                # principal point carry its bias, which sigma does not
+                # cover). fx, cx, cy at COLMAP's positions.
+                if camera["model"] != true["camera_model_name"]:
+                    other_model += 1
+                    continue
+                params, true_params = camera["params"], true["camera_params"]
+                k = pp_index(camera["model"])
+                focal_z.append((params[0] - true_params[0]) / stddev[0])
+                for axis in range(2):
+                    pp_z.append((params[k + axis] - true_params[k + axis]) / stddev[k + axis])
             for camera, true in list(zip(summary["cameras"], truth))[1:]:
                 if not camera.get("calibrated", True) or "uncertainty" not in camera:
                     failed.append(f"{os.path.basename(folder)} {camera['name']}")
@@ -117,33 +152,63 @@ for preset in presets:
                 sigma = camera["uncertainty"]["rotation_stddev_deg"]
                 rot.append(error)
                 rot_z.append(error / sigma)
+                rot_sigma.append(sigma)
                 estimated = centre(pose["rotation_wxyz"], pose["translation"])
                 expected = centre(true["cam_from_rig_rotation"], true["cam_from_rig_translation"])
                 sigmas = camera["uncertainty"]["center_in_rig_stddev"]
                 for k in range(3):
                     axes[k].append(estimated[k] - expected[k])
                     axes_z.append((estimated[k] - expected[k]) / sigmas[k])
+                    axes_sigma[k].append(sigmas[k])
         stats[(preset, case)] = dict(
             rotation=rms(rot), axes=[rms(a) for a in axes],
+            rotation_sigma=rms(rot_sigma),
+            centre_sigma=math.sqrt(sum(rms(a) ** 2 for a in axes_sigma)),
             centre=math.sqrt(sum(rms(a) ** 2 for a in axes)), rotation_z=rms(rot_z),
             centre_z=rms(axes_z), max_z=max([abs(z) for z in rot_z + axes_z], default=float("nan")),
-            n=len(rot))
+            n=len(rot), focal=rms(focal), focal_z=rms(focal_z), pp=rms(pp), pp_z=rms(pp_z),
+            projection=rms(projection), intrinsics_n=len(focal), other_model=other_model,
+            intrinsics_max_z=max([abs(z) for z in focal_z + pp_z], default=float("nan")))
 rows = [f"{rate_hz} Hz, {num_seeds} seeds, 1080 rows; RMS over the non-reference cameras "
         "of every seed; z = error / sigma",
         "",
         "| preset | case | cameras | rotation (deg) | centre x, y, z (mm) | centre (mm) "
-        "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre |",
-        "|---|---|---|---|---|---|---|---|---|---|"]
+        "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre "
+        "| sigma (d) / (a): rotation, centre |",
+        "|---|---|---|---|---|---|---|---|---|---|---|"]
+for preset in presets:
+    for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
+        s = stats[(preset, case)]
+        ratio = sigma_ratio = "-"
+        if case == "d":
+            a = stats[(preset, "a")]
+            ratio = f"{s['rotation'] / a['rotation']:.2f}, {s['centre'] / a['centre']:.2f}"
+            sigma_ratio = (f"{s['rotation_sigma'] / a['rotation_sigma']:.2f}, "
+                           f"{s['centre_sigma'] / a['centre_sigma']:.2f}")
+        rows.append(f"| {preset} | {label} | {s['n']} | {s['rotation']:.4f} "
+                    f"| {', '.join(f'{1e3 * v:.3f}' for v in s['axes'])} | {1e3 * s['centre']:.3f} "
+                    f"| {s['rotation_z']:.2f} | {s['centre_z']:.2f} | {s['max_z']:.1f} | {ratio} "
+                    f"| {sigma_ratio} |")
+rows += ["", "Intrinsics, RMS over every camera of every seed (the reference camera's "
+         "too); z (fx, the principal point per axis) over the cameras whose chosen model is "
+         "the lens's",
+         "",
+         "| preset | case | cameras | another model | focal (%) | principal point (px) "
+         "| projection, max (px) | focal z | principal point z | largest abs z "
+         "| (d) / (a): focal, principal point, projection |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
 for preset in presets:
     for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
         s = stats[(preset, case)]
         ratio = "-"
         if case == "d":
             a = stats[(preset, "a")]
-            ratio = f"{s['rotation'] / a['rotation']:.2f}, {s['centre'] / a['centre']:.2f}"
-        rows.append(f"| {preset} | {label} | {s['n']} | {s['rotation']:.4f} "
-                    f"| {', '.join(f'{1e3 * v:.3f}' for v in s['axes'])} | {1e3 * s['centre']:.3f} "
-                    f"| {s['rotation_z']:.2f} | {s['centre_z']:.2f} | {s['max_z']:.1f} | {ratio} |")
+            ratio = (f"{s['focal'] / a['focal']:.2f}, {s['pp'] / a['pp']:.2f}, "
+                     f"{s['projection'] / a['projection']:.2f}")
+        rows.append(f"| {preset} | {label} | {s['intrinsics_n']} | {s['other_model']} "
+                    f"| {s['focal']:.4f} "
+                    f"| {s['pp']:.3f} | {s['projection']:.3f} | {s['focal_z']:.2f} "
+                    f"| {s['pp_z']:.2f} | {s['intrinsics_max_z']:.1f} | {ratio} |")
 if failed:
     rows += ["", "Failed or without sigma (left out): " + ", ".join(failed)]
 with open(os.path.join(results, "time_model_seeds.md"), "w") as table:

@@ -402,9 +402,8 @@ bool RunCaptureTimeModel(const PipelineOptions& options,
             << " s: they do not follow the rig's motion, and the time "
                "model's offsets hold each camera's centre against the rig's "
                "velocity only as well as its prior does; the sigmas of "
-               "cam_from_rig can be too small (on synthetic rigs at 5 Hz the "
-               "rotation errors were 1.4-1.5 sigma RMS on two of three "
-               "presets). Record "
+               "cam_from_rig can be too small (on synthetic rigs at 5 and 10 "
+               "Hz the rotation errors were up to 1.5 sigma RMS). Record "
                "framesets at 15 Hz or faster, or compare with a calibration "
                "from other framesets";
     AddDiagnostic(report, Diagnostic::Level::kWarning,

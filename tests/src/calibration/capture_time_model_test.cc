@@ -487,6 +487,28 @@ TEST(CaptureTimeModel, DefaultPathAt5HzAnd1080RowsChoosesTheTrueModels) {
   EXPECT_LT(error.centre, 0.8e-3);
 }
 
+// The ring's case (d) at 10 Hz (seed 0, 60 framesets, 1080 rows): the
+// framesets are 0.1 s apart, and over 5 seeds the ring's rotation errors at
+// 10 Hz were 1.48 sigma RMS and 1.34 times the synchronized rig's, as at
+// 5 Hz (docs/time_model.md, "Over many seeds"): the command warns. The
+// timing is within the issue's bounds all the same, and the rig within the
+// 15 Hz test's bounds (measured 0.0091 deg, 0.37 mm; one draw).
+TEST(CaptureTimeModel, DefaultPathAt10HzWarnsThatSigmaCanBeTooSmall) {
+  SyntheticRig rig =
+      GenerateSyntheticRig(BenchmarkCaseD(RigPreset::kRing5, 10));
+  const TimedRun run = CalibrateWithAutomaticModels(&rig, true);
+  const CaptureTimeModel& model = run.report.capture_time_model;
+  ASSERT_TRUE(model.time_offsets_kept && model.line_delays_kept)
+      << model.message;
+  ExpectTimingWithinTheIssuesBounds(model, rig.truth);
+  EXPECT_TRUE(Warns(run.report, "time_model_framesets_sparse"));
+  const RigError error = ErrorOfRig(run.calibration, rig.truth);
+  std::cout << "10 Hz ring, 1080 rows, models auto: rig " << error.rotation_deg
+            << " deg, " << error.centre * 1e3 << " mm" << std::endl;
+  EXPECT_LT(error.rotation_deg, 0.03);
+  EXPECT_LT(error.centre, 1.2e-3);
+}
+
 // The benchmark's helmet case (d) at 15 Hz (scripts/benchmark_time_model.sh
 // with FRAMESET_RATE_HZ=15: seed 0, 60 framesets, 1080 rows, offsets in
 // +-50 ms, 20-30 us per row; default path, points refined). The images are
