@@ -169,46 +169,38 @@ for preset in presets:
             n=len(rot), focal=rms(focal), focal_z=rms(focal_z), pp=rms(pp), pp_z=rms(pp_z),
             projection=rms(projection), intrinsics_n=len(focal), other_model=other_model,
             intrinsics_max_z=max([abs(z) for z in focal_z + pp_z], default=float("nan")))
+def table(header, cells, ratio_groups):
+    """Markdown rows: per preset and case the cells of its stats, then per
+    group of keys the ratios (d) / (a) ("-" on the row of (a))."""
+    lines = [header, "|---" * (header.count("|") - 1) + "|"]
+    for preset in presets:
+        for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
+            s, a = stats[(preset, case)], stats[(preset, "a")]
+            ratios = [", ".join(f"{s[k] / a[k]:.2f}" for k in keys) if case == "d" else "-"
+                      for keys in ratio_groups]
+            lines.append("| " + " | ".join([preset, label] + cells(s) + ratios) + " |")
+    return lines
+
 rows = [f"{rate_hz} Hz, {num_seeds} seeds, 1080 rows; RMS over the non-reference cameras "
-        "of every seed; z = error / sigma",
-        "",
-        "| preset | case | cameras | rotation (deg) | centre x, y, z (mm) | centre (mm) "
-        "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre "
-        "| sigma (d) / (a): rotation, centre |",
-        "|---|---|---|---|---|---|---|---|---|---|---|"]
-for preset in presets:
-    for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
-        s = stats[(preset, case)]
-        ratio = sigma_ratio = "-"
-        if case == "d":
-            a = stats[(preset, "a")]
-            ratio = f"{s['rotation'] / a['rotation']:.2f}, {s['centre'] / a['centre']:.2f}"
-            sigma_ratio = (f"{s['rotation_sigma'] / a['rotation_sigma']:.2f}, "
-                           f"{s['centre_sigma'] / a['centre_sigma']:.2f}")
-        rows.append(f"| {preset} | {label} | {s['n']} | {s['rotation']:.4f} "
-                    f"| {', '.join(f'{1e3 * v:.3f}' for v in s['axes'])} | {1e3 * s['centre']:.3f} "
-                    f"| {s['rotation_z']:.2f} | {s['centre_z']:.2f} | {s['max_z']:.1f} | {ratio} "
-                    f"| {sigma_ratio} |")
+        "of every seed; z = error / sigma", ""]
+rows += table("| preset | case | cameras | rotation (deg) | centre x, y, z (mm) | centre (mm) "
+              "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre "
+              "| sigma (d) / (a): rotation, centre |",
+              lambda s: [str(s["n"]), f"{s['rotation']:.4f}",
+                         ", ".join(f"{1e3 * v:.3f}" for v in s["axes"]),
+                         f"{1e3 * s['centre']:.3f}", f"{s['rotation_z']:.2f}",
+                         f"{s['centre_z']:.2f}", f"{s['max_z']:.1f}"],
+              [("rotation", "centre"), ("rotation_sigma", "centre_sigma")])
 rows += ["", "Intrinsics, RMS over every camera of every seed (the reference camera's "
          "too); z (fx, the principal point per axis) over the cameras whose chosen model is "
-         "the lens's",
-         "",
-         "| preset | case | cameras | another model | focal (%) | principal point (px) "
-         "| projection, max (px) | focal z | principal point z | largest abs z "
-         "| (d) / (a): focal, principal point, projection |",
-         "|---|---|---|---|---|---|---|---|---|---|---|"]
-for preset in presets:
-    for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
-        s = stats[(preset, case)]
-        ratio = "-"
-        if case == "d":
-            a = stats[(preset, "a")]
-            ratio = (f"{s['focal'] / a['focal']:.2f}, {s['pp'] / a['pp']:.2f}, "
-                     f"{s['projection'] / a['projection']:.2f}")
-        rows.append(f"| {preset} | {label} | {s['intrinsics_n']} | {s['other_model']} "
-                    f"| {s['focal']:.4f} "
-                    f"| {s['pp']:.3f} | {s['projection']:.3f} | {s['focal_z']:.2f} "
-                    f"| {s['pp_z']:.2f} | {s['intrinsics_max_z']:.1f} | {ratio} |")
+         "the lens's", ""]
+rows += table("| preset | case | cameras | another model | focal (%) | principal point (px) "
+              "| projection, max (px) | focal z | principal point z | largest abs z "
+              "| (d) / (a): focal, principal point, projection |",
+              lambda s: [str(s["intrinsics_n"]), str(s["other_model"]), f"{s['focal']:.4f}",
+                         f"{s['pp']:.3f}", f"{s['projection']:.3f}", f"{s['focal_z']:.2f}",
+                         f"{s['pp_z']:.2f}", f"{s['intrinsics_max_z']:.1f}"],
+              [("focal", "pp", "projection")])
 if failed:
     rows += ["", "Failed or without sigma (left out): " + ", ".join(failed)]
 with open(os.path.join(results, "time_model_seeds.md"), "w") as table:
