@@ -93,7 +93,7 @@ struct CaptureTimeModelOptions {
   // 1080 rows, offsets in +-50 ms) the ring's rotation errors were 1.46
   // times their sigma (RMS) at 5 Hz (5 seeds) and 1.48 at 10 Hz (5 seeds),
   // 1.89 and 1.34 times the same rig's synchronized; at 15 Hz (8 seeds)
-  // 1.22 and 1.24 times (synchronized: 1.0-1.2 sigma). The threshold lies
+  // 1.22 and 1.25 times (synchronized: 1.0-1.2 sigma). The threshold lies
   // between 15 Hz (0.067 s) and 10 Hz (0.1 s).
   double max_followed_frameset_interval_s = 0.08;
   // Inliers of the start: within this reprojection error of today's result
