@@ -29,6 +29,10 @@
 #   FRAMESET_RATE_HZ          frameset rate (default 15)
 #   SEEDS                     seeds (default: 1 2 3 4 5 6 7 8)
 #   JOBS                      calibrations at once (default 2)
+#   BOB_HZ                    the body's bob at this frequency instead of the
+#                             preset's (rig_calibrator_lab synthetic --bob_hz;
+#                             e.g. 4.83: the car shaking faster than 15 Hz
+#                             framesets follow)
 set -euo pipefail
 
 log_tag=benchmark_time_model_seeds
@@ -43,6 +47,7 @@ unit_s="$(/usr/bin/python3 -c "print(1 / $rate_hz)")"
 read -r -a presets <<<"${TIME_MODEL_PRESETS:-ring5 fisheye_helmet5 car_surround4}"
 read -r -a seeds <<<"${SEEDS:-1 2 3 4 5 6 7 8}"
 jobs="${JOBS:-2}"
+bob_hz="${BOB_HZ:-0}"
 [[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
 mkdir -p "$results" || die "cannot create $results"
 results="$(cd "$results" && pwd)"
@@ -52,6 +57,7 @@ run_one() {
   local preset="$1" case_name="$2" seed="$3"
   local dir="$results/${preset}_${case_name}_$seed" options=""
   [[ $case_name == d ]] && options="--max_time_offset_ms 50 --line_delay_us 20,30"
+  [[ $bob_hz == 0 ]] || options+=" --bob_hz $bob_hz"
   rm -rf "$dir"
   mkdir -p "$dir"
   # shellcheck disable=SC2086
@@ -70,7 +76,7 @@ run_one() {
   echo "[$log_tag] $preset ($case_name) seed $seed done"
 }
 export -f run_one
-export results framesets rate_hz unit_s rig_calibrator rig_calibrator_lab log_tag
+export results framesets rate_hz bob_hz unit_s rig_calibrator rig_calibrator_lab log_tag
 
 for preset in "${presets[@]}"; do
   for seed in "${seeds[@]}"; do
@@ -79,10 +85,11 @@ for preset in "${presets[@]}"; do
 done | xargs -P "$jobs" -L 1 bash -c 'run_one "$0" "$1" "$2"' ||
   die "a data set could not be generated (see above)"
 
-/usr/bin/python3 - "$results" "$rate_hz" "${#seeds[@]}" "${presets[@]}" <<'EOF'
+/usr/bin/python3 - "$results" "$rate_hz" "$bob_hz" "${#seeds[@]}" "${presets[@]}" <<'EOF'
 import glob, json, math, os, sys
 
-results, rate_hz, num_seeds, presets = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+results, rate_hz, bob_hz, num_seeds = sys.argv[1:5]
+presets = sys.argv[5:]
 
 def rotation(q):
     w, x, y, z = (v / math.sqrt(sum(c * c for c in q)) for v in q)
@@ -181,7 +188,8 @@ def table(header, cells, ratio_groups):
             lines.append("| " + " | ".join([preset, label] + cells(s) + ratios) + " |")
     return lines
 
-rows = [f"{rate_hz} Hz, {num_seeds} seeds, 1080 rows; RMS over the non-reference cameras "
+bob = "" if bob_hz == "0" else f", the body bobbing at {bob_hz} Hz"
+rows = [f"{rate_hz} Hz, {num_seeds} seeds, 1080 rows{bob}; RMS over the non-reference cameras "
         "of every seed; z = error / sigma", ""]
 rows += table("| preset | case | cameras | rotation (deg) | centre x, y, z (mm) | centre (mm) "
               "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre "

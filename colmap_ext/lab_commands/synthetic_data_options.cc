@@ -53,6 +53,9 @@ void AddTimeModelOptions(
             "time model: the rig's ground speed (metres per second)");
   AddOption(description, "max_turn_rate_deg_s", &options->max_turn_rate_deg_s,
             "time model: the rig's peak heading rate (degrees per second)");
+  AddOption(description, "bob_hz", &options->bob_hz,
+            "time model: the body bobs up and down at this frequency (Hz) "
+            "with the preset's amplitude (0: the preset's bob)");
   AddOption(description, "max_time_offset_ms",
             &arguments->max_time_offset_ms,
             "time model: capture-time offsets of cam1, cam2, ... drawn in "

@@ -27,7 +27,7 @@ struct TimeModelArguments {
 };
 
 // The time model of `rig_calibrator_lab synthetic` and `render`:
-// --frameset_rate_hz, --speed_m_s, --max_turn_rate_deg_s (bound to
+// --frameset_rate_hz, --speed_m_s, --max_turn_rate_deg_s, --bob_hz (bound to
 // *options), and
 // --max_time_offset_ms, --camera_time_offsets_ms, --line_delay_us,
 // --camera_line_delays_us (bound to *arguments; ApplyTimeModelArguments

@@ -228,7 +228,8 @@ bool PlanRigWalk(const RenderedDatasetOptions& options, std::mt19937* random,
   RigGroundTruth& rig = plan->rig;
   rig = MakeRigPreset(options.preset);
   rig.body_from_rig = BodyFromRig(rig.cam_from_rig);
-  MotionProfile motion = MakePresetDefinition(options.preset, 0).motion;
+  MotionProfile motion = TimeModelMotion(
+      time_model, MakePresetDefinition(options.preset, 0).motion);
   motion.height_m =
       options.rig_height > 0 ? options.rig_height : walk.eye_height;
   rig.trajectory.emplace(motion, time_model.speed_m_s,

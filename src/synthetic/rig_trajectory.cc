@@ -92,17 +92,28 @@ void RigTrajectory::AnglesAt(double t, Angles* angles, Angles* rates) const {
   }
 }
 
+double RigTrajectory::BobAt(double t, double* rate) const {
+  // The argument grows by 2 pi per T_bob, or by pi per profile step.
+  if (motion_.bob_period_s > 0) {
+    const double frequency = 2 * M_PI / motion_.bob_period_s;
+    *rate = motion_.bob_m * frequency * std::cos(frequency * t + bob_phase_);
+    return motion_.bob_m * std::sin(frequency * t + bob_phase_);
+  }
+  const double s = t / seconds_per_step_;
+  *rate = motion_.bob_m * M_PI / seconds_per_step_ *
+          std::cos(M_PI * s + bob_phase_);
+  return motion_.bob_m * std::sin(M_PI * s + bob_phase_);
+}
+
 Eigen::Vector3d RigTrajectory::PositionAt(double t) const {
   const double time = rotation_only_ ? 0.0 : t;
+  double bob_rate = 0;
+  const double height = motion_.height_m + BobAt(time, &bob_rate);
   if (loop_) {
     double angle_rate_per_m = 0;
     const Eigen::Vector2d ground =
         loop_->PointAt(loop_->AngleAt(speed_m_s_ * time, &angle_rate_per_m));
-    return Eigen::Vector3d(
-        ground.x(), ground.y(),
-        motion_.height_m +
-            motion_.bob_m *
-                std::sin(M_PI * time / seconds_per_step_ + bob_phase_));
+    return Eigen::Vector3d(ground.x(), ground.y(), height);
   }
   // The track heading psi = kappa t (kappa = r_yaw / tau, rad/s); the
   // position is the integral of v (cos psi, sin psi):
@@ -112,11 +123,9 @@ Eigen::Vector3d RigTrajectory::PositionAt(double t) const {
   const double kappa =
       colmap::DegToRad(motion_.yaw_rate_deg) / seconds_per_step_;
   const double half_angle = 0.5 * kappa * time;
-  const double s = time / seconds_per_step_;
   return Eigen::Vector3d(
       speed_m_s_ * time * Sinc(kappa * time),
-      speed_m_s_ * time * std::sin(half_angle) * Sinc(half_angle),
-      motion_.height_m + motion_.bob_m * std::sin(M_PI * s + bob_phase_));
+      speed_m_s_ * time * std::sin(half_angle) * Sinc(half_angle), height);
 }
 
 Rigid3d RigTrajectory::WorldFromBody(double t) const {
@@ -133,9 +142,8 @@ Rigid3d RigTrajectory::WorldFromBody(double t) const {
 
 Eigen::Vector3d RigTrajectory::LinearVelocity(double t) const {
   if (rotation_only_) return Eigen::Vector3d::Zero();
-  const double s = t / seconds_per_step_;
-  const double bob_rate = motion_.bob_m * M_PI / seconds_per_step_ *
-                          std::cos(M_PI * s + bob_phase_);
+  double bob_rate = 0;
+  BobAt(t, &bob_rate);
   if (loop_) {
     double angle_rate_per_m = 0;
     const double angle = loop_->AngleAt(speed_m_s_ * t, &angle_rate_per_m);

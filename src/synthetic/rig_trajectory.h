@@ -15,7 +15,11 @@
 //              psi: x = v t sinc(kappa t), y = v t sin(kappa t / 2)
 //              sinc(kappa t / 2), kappa = r_yaw / tau (a circular arc, or a
 //              line for r_yaw = 0)
-//   height     z(t) = h + b sin(pi s + phi_bob)   (a bob every 2 steps)
+//   height     z(t) = h + b sin(pi s + phi_bob)   (a bob every 2 steps: a
+//              walker's gait, whose pace the profile sets), or
+//              z(t) = h + b sin(2 pi t / T_bob + phi_bob) with a period
+//              T_bob in seconds (a vehicle body bouncing on its suspension,
+//              at its own frequency however fast the profile is played)
 // tau is chosen so that the heading rate peaks at the requested turn rate:
 // max_t yaw'(t) = (A_yaw 2 pi / P_yaw + |r_yaw|) / tau = max_turn_rate. The
 // profile keeps its amplitudes (how far the rig looks around) and its
@@ -47,6 +51,8 @@ struct MotionProfile {
   double step_m = 0.4;    // distance between framesets
   double height_m = 1.6;  // body origin above the ground
   double bob_m = 0.03;
+  // T_bob above, seconds; 0: a bob every 2 profile steps.
+  double bob_period_s = 0;
   double yaw_amplitude_deg = 40, yaw_period = 25, yaw_rate_deg = 3;
   double pitch_amplitude_deg = 8, pitch_period = 17;
   double roll_amplitude_deg = 6, roll_period = 13;
@@ -92,6 +98,9 @@ class RigTrajectory {
   void AnglesAt(double t, Angles* angles, Angles* rates) const;
   // The unscaled body position at t.
   Eigen::Vector3d PositionAt(double t) const;
+  // The bob's height above h at t and its rate (map units per second,
+  // unscaled).
+  double BobAt(double t, double* rate) const;
 
   MotionProfile motion_;
   std::optional<GroundLoop> loop_;

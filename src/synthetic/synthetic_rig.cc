@@ -169,7 +169,7 @@ void GenerateImage(const SyntheticRigOptions& options,
 void AddTimeModel(const SyntheticRigOptions& options,
                   const MotionProfile& motion, const Rigid3d& body_from_rig,
                   std::mt19937* rng, RigGroundTruth* truth) {
-  truth->trajectory.emplace(motion, options.speed_m_s,
+  truth->trajectory.emplace(TimeModelMotion(options, motion), options.speed_m_s,
                             options.max_turn_rate_deg_s, options.rotation_only,
                             rng);
   truth->body_from_rig = body_from_rig;
@@ -250,6 +250,10 @@ bool CheckTimeModel(const SyntheticRigOptions& options,
              << options.speed_m_s << ", " << options.max_turn_rate_deg_s;
     return false;
   }
+  if (!(options.bob_hz >= 0 && std::isfinite(options.bob_hz))) {
+    *message << "bob_hz must be >= 0 and finite, got " << options.bob_hz;
+    return false;
+  }
   if (!(options.max_time_offset_s >= 0 &&
         std::isfinite(options.max_time_offset_s))) {
     *message << "max_time_offset_s must be >= 0 and finite, got "
@@ -263,15 +267,14 @@ bool CheckTimeModel(const SyntheticRigOptions& options,
              << options.min_line_delay_s << ", " << options.max_line_delay_s;
     return false;
   }
-  if (rate == 0 && (options.speed_m_s != defaults.speed_m_s ||
-                    options.max_turn_rate_deg_s !=
-                        defaults.max_turn_rate_deg_s ||
-                    options.max_time_offset_s > 0 ||
-                    !options.time_offsets_s.empty() ||
-                    options.max_line_delay_s > 0 ||
-                    !options.line_delays_s.empty())) {
-    *message << "speed_m_s, max_turn_rate_deg_s, time offsets and line "
-                "delays need the time model, frameset_rate_hz > 0";
+  if (rate == 0 &&
+      (options.speed_m_s != defaults.speed_m_s ||
+       options.max_turn_rate_deg_s != defaults.max_turn_rate_deg_s ||
+       options.bob_hz != defaults.bob_hz || options.max_time_offset_s > 0 ||
+       !options.time_offsets_s.empty() || options.max_line_delay_s > 0 ||
+       !options.line_delays_s.empty())) {
+    *message << "speed_m_s, max_turn_rate_deg_s, bob_hz, time offsets and "
+                "line delays need the time model, frameset_rate_hz > 0";
     return false;
   }
   const std::vector<CameraSpec> cameras = DefinitionOf(options).cameras;
@@ -341,6 +344,12 @@ void DrawCaptureTimes(const SyntheticRigOptions& options,
       truth->line_delays_s.push_back(line_delay(time_rng));
     }
   }
+}
+
+MotionProfile TimeModelMotion(const SyntheticRigOptions& options,
+                              MotionProfile motion) {
+  if (options.bob_hz > 0) motion.bob_period_s = 1 / options.bob_hz;
+  return motion;
 }
 
 std::string FramesetName(int frameset) {

@@ -163,6 +163,11 @@ struct SyntheticRigOptions {
   // played at the same pace.
   double speed_m_s = 1.5;
   double max_turn_rate_deg_s = 60;
+  // With frameset_rate_hz > 0: > 0, the body bobs up and down at this
+  // frequency (Hz) with the preset's amplitude, instead of the preset's
+  // own bob (MotionProfile::bob_period_s); e.g. a vibration faster than
+  // the framesets follow.
+  double bob_hz = 0;
   // With frameset_rate_hz > 0: the capture-time offset delta_c of every
   // camera but the reference camera 0 (whose offset is 0), drawn uniformly
   // in [-max_time_offset_s, max_time_offset_s] (seconds); or, when
@@ -183,6 +188,11 @@ struct SyntheticRigOptions {
   // than the defaults without frameset_rate_hz > 0.
   bool Check(std::string* error) const;
 };
+
+// The preset's motion profile with options.bob_hz applied (the time
+// model's trajectory).
+MotionProfile TimeModelMotion(const SyntheticRigOptions& options,
+                              MotionProfile motion);
 
 struct SyntheticRig {
   // Cameras: same model and size as the truth, parameters = initial guesses

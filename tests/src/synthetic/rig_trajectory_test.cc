@@ -90,6 +90,57 @@ TEST(RigTrajectory, VelocitiesAreTheDerivativesOfThePoses) {
   }
 }
 
+// The car's body bounces at its own 1.25 Hz (MotionProfile::bob_period_s,
+// 0.8 s) whatever the turn rate that sets the profile's pace: its height
+// repeats after 0.8 s, not after half of it, its vertical velocity is the
+// derivative of the height, and the vertical acceleration peaks at
+// b (2 pi / T)^2 = 0.62 m/s^2. A walker's bob (every 2 profile steps)
+// follows the pace: at twice the turn rate it bobs twice as fast.
+TEST(RigTrajectory, CarBouncesAtItsOwnFrequencyWalkerAtThePace) {
+  const MotionProfile car =
+      MakePresetDefinition(RigPreset::kCarSurround4, 0).motion;
+  ASSERT_EQ(car.bob_period_s, 0.8);
+  const double h = 1e-4;
+  for (const double turn_rate_deg : {30.0, 60.0}) {
+    const RigTrajectory trajectory = TrajectoryOf(car, 1.5, turn_rate_deg, 2);
+    double max_acceleration = 0;
+    for (double t = 0; t < 4; t += 0.013) {
+      const double z = trajectory.WorldFromBody(t).translation.z();
+      EXPECT_NEAR(trajectory.WorldFromBody(t + 0.8).translation.z(), z, 1e-12)
+          << t;
+      const double before = trajectory.WorldFromBody(t - h).translation.z();
+      const double after = trajectory.WorldFromBody(t + h).translation.z();
+      EXPECT_NEAR((after - before) / (2 * h), trajectory.LinearVelocity(t).z(),
+                  1e-6)
+          << t;
+      max_acceleration = std::max(max_acceleration,
+                                  std::abs(after - 2 * z + before) / (h * h));
+    }
+    EXPECT_NEAR(max_acceleration, car.bob_m * std::pow(2 * M_PI / 0.8, 2),
+                0.01);
+    // Half a period later the bob is at its opposite (z = -z about h).
+    EXPECT_GT(std::abs(trajectory.WorldFromBody(0.4).translation.z() -
+                       trajectory.WorldFromBody(0).translation.z()) +
+                  std::abs(trajectory.WorldFromBody(0.6).translation.z() -
+                           trajectory.WorldFromBody(0.2).translation.z()),
+              car.bob_m);
+  }
+  // The walker: the bob's vertical speed peaks at b pi / tau, tau halving
+  // when the turn rate doubles.
+  const MotionProfile walk =
+      MakePresetDefinition(RigPreset::kFisheyeHelmet5, 0).motion;
+  ASSERT_EQ(walk.bob_period_s, 0);
+  double peak[2] = {0, 0};
+  for (int i = 0; i < 2; ++i) {
+    const RigTrajectory trajectory =
+        TrajectoryOf(walk, 1.5, i == 0 ? 30.0 : 60.0, 2);
+    for (double t = 0; t < 4; t += 1e-3) {
+      peak[i] = std::max(peak[i], std::abs(trajectory.LinearVelocity(t).z()));
+    }
+  }
+  EXPECT_NEAR(peak[1] / peak[0], 2.0, 1e-3);
+}
+
 // On a ground loop (the rendered rig's walk, the courtyard's proportions):
 // over 30 s (more than a lap) the body stays on the ellipse at its height
 // plus the bob, at the requested ground speed; the heading rate never

@@ -252,6 +252,30 @@ TEST(SyntheticTimeModel, DefaultsKeepTheEarlierData) {
 
 // Selecting framesets keeps their times in the truth and, in time order, in
 // the dataset; map_scale scales the continuous poses like the sampled ones.
+// bob_hz replaces the preset's bob (the car's 1.25 Hz) by one at that
+// frequency with the preset's amplitude: the body's height repeats after
+// 1 / bob_hz, and the data still reproduce with every observation's time.
+TEST(SyntheticTimeModel, BobAtTheAskedFrequency) {
+  SyntheticRigOptions options = ExactTimedOptions(RigPreset::kCarSurround4);
+  options.bob_hz = 4;
+  options.max_time_offset_s = 0.05;
+  const SyntheticRig rig = GenerateSyntheticRig(options);
+  ASSERT_TRUE(rig.truth.trajectory.has_value());
+  const RigTrajectory& trajectory = *rig.truth.trajectory;
+  double max_vertical_speed = 0;
+  for (double t = 0; t < 2; t += 0.01) {
+    EXPECT_NEAR(trajectory.WorldFromBody(t + 0.25).translation.z(),
+                trajectory.WorldFromBody(t).translation.z(), 1e-12);
+    max_vertical_speed = std::max(max_vertical_speed,
+                                  std::abs(trajectory.LinearVelocity(t).z()));
+  }
+  // b 2 pi f, the preset's 1 cm at 4 Hz.
+  EXPECT_NEAR(max_vertical_speed, 0.01 * 2 * M_PI * 4, 1e-3);
+  double max_error = 0, median_nominal = 0;
+  Errors(rig, &max_error, &median_nominal);
+  EXPECT_LT(max_error, 1e-9);
+}
+
 TEST(SyntheticTimeModel, SelectedFramesetsAndMapScale) {
   SyntheticRigOptions options = ExactTimedOptions(RigPreset::kRing5);
   options.points_per_image = 10;
@@ -284,8 +308,8 @@ TEST(SyntheticTimeModel, SelectedFramesetsAndMapScale) {
 
 // Every bad time-model option is refused with a message naming it.
 TEST(SyntheticTimeModel, BadOptionsAreRefused) {
-  const std::vector<std::pair<std::function<void(SyntheticRigOptions*)>,
-                              std::string>>
+  const std::vector<
+      std::pair<std::function<void(SyntheticRigOptions*)>, std::string>>
       cases = {
           {[](SyntheticRigOptions* o) { o->frameset_rate_hz = -1; },
            "frameset_rate_hz must be >= 0"},
@@ -294,6 +318,13 @@ TEST(SyntheticTimeModel, BadOptionsAreRefused) {
           {[](SyntheticRigOptions* o) { o->speed_m_s = 0; }, "speed_m_s"},
           {[](SyntheticRigOptions* o) { o->max_turn_rate_deg_s = -5; },
            "max_turn_rate_deg_s"},
+          {[](SyntheticRigOptions* o) { o->bob_hz = -1; },
+           "bob_hz must be >= 0"},
+          {[](SyntheticRigOptions* o) {
+             o->frameset_rate_hz = 0;
+             o->bob_hz = 2;
+           },
+           "need the time model"},
           {[](SyntheticRigOptions* o) { o->max_time_offset_s = -0.01; },
            "max_time_offset_s must be >= 0"},
           {[](SyntheticRigOptions* o) { o->max_line_delay_s = -1e-6; },
@@ -318,7 +349,9 @@ TEST(SyntheticTimeModel, BadOptionsAreRefused) {
              o->speed_m_s = 3;
            },
            "need the time model"},
-          {[](SyntheticRigOptions* o) { o->time_offsets_s = {0, 0.01}; },
+          {[](SyntheticRigOptions* o) {
+             o->time_offsets_s = {0, 0.01};
+           },
            "time_offsets_s needs one finite offset per camera (5)"},
           {[](SyntheticRigOptions* o) {
              o->time_offsets_s = {0.01, 0, 0, 0, 0};
