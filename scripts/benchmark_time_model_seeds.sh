@@ -16,7 +16,9 @@
 # case); over every camera (the reference camera's intrinsics are estimated
 # too) the same for the focal length (fx, in %), the principal point (px)
 # and the largest projection difference from the true model over the image
-# (`rig_calibrator evaluate`).
+# (`rig_calibrator evaluate`); and the turn common to the non-reference
+# cameras against the reference camera (their rotation errors' mean per
+# seed), apart from each camera's own.
 #
 # Usage: scripts/benchmark_time_model_seeds.sh RESULTS_DIR [FRAMESETS]
 #   RESULTS_DIR  created if needed; gets time_model_seeds.md (the tables),
@@ -108,6 +110,16 @@ def angle_deg(q, p):  # the angle of q p^-1
     norm = math.sqrt(sum(c * c for c in q) * sum(c * c for c in p))
     return math.degrees(2 * math.acos(min(1.0, abs(w) / norm)))
 
+def turn_deg(q_true, q):
+    """The rotation vector (degrees) of R_true^T R of cam_from_rig: the turn
+    of the estimated camera against the true one, in the rig frame."""
+    a, b = rotation(q_true), rotation(q)
+    m = [[sum(a[k][i] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    angle = math.acos(max(-1.0, min(1.0, (m[0][0] + m[1][1] + m[2][2] - 1) / 2)))
+    scale = angle / (2 * math.sin(angle)) if angle > 1e-12 else 0.5
+    return [math.degrees(scale * v) for v in
+            (m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1])]
+
 def pp_index(model):
     one_focal = ("SIMPLE_PINHOLE", "SIMPLE_RADIAL", "RADIAL", "SIMPLE_RADIAL_FISHEYE",
                  "RADIAL_FISHEYE")
@@ -123,6 +135,7 @@ for preset in presets:
         rot, rot_z, axes, axes_z = [], [], [[], [], []], []
         rot_sigma, axes_sigma = [], [[], [], []]
         focal, focal_z, pp, pp_z, projection, other_model = [], [], [], [], [], 0
+        common, own = [], []  # per seed the non-reference cameras' mean turn; each one's about it
         for folder in sorted(glob.glob(os.path.join(results, f"{preset}_{case}_*"))):
             if os.path.exists(os.path.join(folder, "calibration.failed")):
                 failed.append(os.path.basename(folder))
@@ -150,11 +163,13 @@ for preset in presets:
                 focal_z.append((params[0] - true_params[0]) / stddev[0])
                 for axis in range(2):
                     pp_z.append((params[k + axis] - true_params[k + axis]) / stddev[k + axis])
+            turns = []
             for camera, true in list(zip(summary["cameras"], truth))[1:]:
                 if not camera.get("calibrated", True) or "uncertainty" not in camera:
                     failed.append(f"{os.path.basename(folder)} {camera['name']}")
                     continue
                 pose = camera["cam_from_rig"]
+                turns.append(turn_deg(true["cam_from_rig_rotation"], pose["rotation_wxyz"]))
                 error = angle_deg(pose["rotation_wxyz"], true["cam_from_rig_rotation"])
                 sigma = camera["uncertainty"]["rotation_stddev_deg"]
                 rot.append(error)
@@ -167,7 +182,19 @@ for preset in presets:
                     axes[k].append(estimated[k] - expected[k])
                     axes_z.append((estimated[k] - expected[k]) / sigmas[k])
                     axes_sigma[k].append(sigmas[k])
+            if turns:
+                mean = [sum(t[k] for t in turns) / len(turns) for k in range(3)]
+                common.append(mean)
+                own += [math.dist(t, mean) for t in turns]
+        seeds = len(common)
+        common_mean = [sum(c[k] for c in common) / seeds if seeds else float("nan")
+                       for k in range(3)]
+        common_sd = [math.sqrt(sum((c[k] - common_mean[k]) ** 2 for c in common) / (seeds - 1))
+                     if seeds > 1 else float("nan") for k in range(3)]
         stats[(preset, case)] = dict(
+            seeds=seeds, common=rms([math.hypot(*c) for c in common]), own=rms(own),
+            common_mean=common_mean,
+            common_mean_sigma=[sd / math.sqrt(seeds) for sd in common_sd],
             rotation=rms(rot), axes=[rms(a) for a in axes],
             rotation_sigma=rms(rot_sigma),
             centre_sigma=math.sqrt(sum(rms(a) ** 2 for a in axes_sigma)),
@@ -209,6 +236,17 @@ rows += table("| preset | case | cameras | another model | focal (%) | principal
                          f"{s['pp']:.3f}", f"{s['projection']:.3f}", f"{s['focal_z']:.2f}",
                          f"{s['pp_z']:.2f}", f"{s['intrinsics_max_z']:.1f}"],
               [("focal", "pp", "projection")])
+rows += ["", "The non-reference cameras' rotation errors as turns in the rig frame (R_true^T R "
+         "of cam_from_rig): per seed their mean, the turn common to them against the "
+         "reference camera; RMS of its size over the seeds, its mean per rig axis +- the "
+         "mean's standard error; RMS of each camera's turn about that mean", ""]
+rows += table("| preset | case | seeds | common turn (deg) | its mean x, y, z (deg) "
+              "| each camera's own (deg) | (d) / (a): common, own |",
+              lambda s: [str(s["seeds"]), f"{s['common']:.4f}",
+                         ", ".join(f"{m:+.4f} +- {e:.4f}" for m, e in
+                                   zip(s["common_mean"], s["common_mean_sigma"])),
+                         f"{s['own']:.4f}"],
+              [("common", "own")])
 if failed:
     rows += ["", "Failed or without sigma (left out): " + ", ".join(failed)]
 with open(os.path.join(results, "time_model_seeds.md"), "w") as table:
