@@ -18,7 +18,11 @@
 # and the largest projection difference from the true model over the image
 # (`rig_calibrator evaluate`); and the turn common to the non-reference
 # cameras against the reference camera (their rotation errors' mean per
-# seed), apart from each camera's own.
+# seed), apart from each camera's own. CASES may add (e): (d)'s offsets and
+# line delays, but the reference camera a global shutter (its line delay 0;
+# the others as drawn), compared with (a) as (d) is. Its points and noise
+# are another draw: the reference camera's capture changes which points
+# each image sees, and with them the random stream of every image after it.
 #
 # Usage: scripts/benchmark_time_model_seeds.sh RESULTS_DIR [FRAMESETS]
 #   RESULTS_DIR  created if needed; gets time_model_seeds.md (the tables),
@@ -31,6 +35,10 @@
 #   FRAMESET_RATE_HZ          frameset rate (default 15)
 #   SEEDS                     seeds (default: 1 2 3 4 5 6 7 8)
 #   JOBS                      calibrations at once (default 2)
+#   CASES                     cases to run (default: a d); the tables
+#                             compare each with (a), which must be among
+#                             them or already in RESULTS_DIR for every
+#                             preset and seed
 #   BOB_HZ                    the body's bob at this frequency instead of the
 #                             preset's (rig_calibrator_lab synthetic --bob_hz;
 #                             e.g. 4.83: the car shaking faster than 15 Hz
@@ -48,6 +56,18 @@ rate_hz="${FRAMESET_RATE_HZ:-15}"
 unit_s="$(/usr/bin/python3 -c "print(1 / $rate_hz)")"
 read -r -a presets <<<"${TIME_MODEL_PRESETS:-ring5 fisheye_helmet5 car_surround4}"
 read -r -a seeds <<<"${SEEDS:-1 2 3 4 5 6 7 8}"
+read -r -a cases <<<"${CASES:-a d}"
+for case_name in "${cases[@]}"; do
+  [[ $case_name =~ ^[ade]$ ]] || die "CASES: unknown case '$case_name' (a, d, e)"
+done
+if [[ " ${cases[*]} " != *" a "* ]]; then
+  for preset in "${presets[@]}"; do
+    for seed in "${seeds[@]}"; do
+      [[ -d $results/${preset}_a_$seed ]] ||
+        die "CASES without a needs (a)'s results in $results; no ${preset}_a_$seed"
+    done
+  done
+fi
 jobs="${JOBS:-2}"
 bob_hz="${BOB_HZ:-0}"
 [[ -x "$rig_calibrator" && -x "$rig_calibrator_lab" ]] || die "no $rig_calibrator or $rig_calibrator_lab; build first (scripts/build.sh) or set RIG_CALIBRATOR_BUILD_DIR"
@@ -58,10 +78,28 @@ results="$(cd "$results" && pwd)"
 run_one() {
   local preset="$1" case_name="$2" seed="$3"
   local dir="$results/${preset}_${case_name}_$seed" options=""
-  [[ $case_name == d ]] && options="--max_time_offset_ms 50 --line_delay_us 20,30"
+  [[ $case_name == a ]] || options="--max_time_offset_ms 50 --line_delay_us 20,30"
   [[ $bob_hz == 0 ]] || options+=" --bob_hz $bob_hz"
   rm -rf "$dir"
   mkdir -p "$dir"
+  if [[ $case_name == e ]]; then
+    # (d)'s offsets and line delays (drawn from their own random stream,
+    # read back from a generation of (d)), the reference camera's line
+    # delay 0.
+    # shellcheck disable=SC2086
+    "$rig_calibrator_lab" synthetic --output_path "$dir/draw" --preset "$preset" \
+      --num_framesets "$framesets" --frameset_rate_hz "$rate_hz" --speed_m_s 1.5 \
+      --max_turn_rate_deg_s 60 --image_height 1080 --seed "$seed" $options \
+      >"$dir/synthetic.log" || { echo "generating $dir failed" >&2; return 1; }
+    options="$(/usr/bin/python3 -c '
+import json, sys
+cameras = json.load(open(sys.argv[1]))["cameras"]
+print("--camera_time_offsets_ms", ",".join(repr(1e3 * c["time_offset_s"]) for c in cameras),
+      "--camera_line_delays_us", ",".join(["0"] + [repr(1e6 * c["line_delay_s"]) for c in cameras[1:]]))
+' "$dir/draw/ground_truth/time_model.json")" || { echo "reading $dir/draw failed" >&2; return 1; }
+    [[ $bob_hz == 0 ]] || options+=" --bob_hz $bob_hz"
+    rm -rf "$dir/draw"
+  fi
   # shellcheck disable=SC2086
   "$rig_calibrator_lab" synthetic --output_path "$dir/data" --preset "$preset" \
     --num_framesets "$framesets" --frameset_rate_hz "$rate_hz" --speed_m_s 1.5 \
@@ -82,16 +120,18 @@ export results framesets rate_hz bob_hz unit_s rig_calibrator rig_calibrator_lab
 
 for preset in "${presets[@]}"; do
   for seed in "${seeds[@]}"; do
-    for case_name in a d; do echo "$preset $case_name $seed"; done
+    for case_name in "${cases[@]}"; do echo "$preset $case_name $seed"; done
   done
 done | xargs -P "$jobs" -L 1 bash -c 'run_one "$0" "$1" "$2"' ||
   die "a data set could not be generated (see above)"
 
-/usr/bin/python3 - "$results" "$rate_hz" "$bob_hz" "${#seeds[@]}" "${presets[@]}" <<'EOF'
+table_cases="a ${cases[*]/a/}"
+/usr/bin/python3 - "$results" "$rate_hz" "$bob_hz" "${#seeds[@]}" "$table_cases" "${presets[@]}" <<'EOF'
 import glob, json, math, os, sys
 
-results, rate_hz, bob_hz, num_seeds = sys.argv[1:5]
-presets = sys.argv[5:]
+results, rate_hz, bob_hz, num_seeds, cases = sys.argv[1:6]
+cases = sorted(set(cases.split()))
+presets = sys.argv[6:]
 
 def rotation(q):
     w, x, y, z = (v / math.sqrt(sum(c * c for c in q)) for v in q)
@@ -131,7 +171,7 @@ def rms(values):
 stats = {}
 failed = []
 for preset in presets:
-    for case in ("a", "d"):
+    for case in cases:
         rot, rot_z, axes, axes_z = [], [], [[], [], []], []
         rot_sigma, axes_sigma = [], [[], [], []]
         focal, focal_z, pp, pp_z, projection, other_model = [], [], [], [], [], 0
@@ -205,22 +245,27 @@ for preset in presets:
             intrinsics_max_z=max([abs(z) for z in focal_z + pp_z], default=float("nan")))
 def table(header, cells, ratio_groups):
     """Markdown rows: per preset and case the cells of its stats, then per
-    group of keys the ratios (d) / (a) ("-" on the row of (a))."""
+    group of keys the ratios to (a) ("-" on the row of (a))."""
+    labels = {"a": "(a) synchronized", "d": "(d) offsets and line delays",
+              "e": "(e) as (d), the reference a global shutter"}
     lines = [header, "|---" * (header.count("|") - 1) + "|"]
     for preset in presets:
-        for case, label in (("a", "(a) synchronized"), ("d", "(d) offsets and line delays")):
+        for case in cases:
+            label = labels[case]
             s, a = stats[(preset, case)], stats[(preset, "a")]
-            ratios = [", ".join(f"{s[k] / a[k]:.2f}" for k in keys) if case == "d" else "-"
+            ratios = [", ".join(f"{s[k] / a[k]:.2f}" for k in keys) if case != "a" else "-"
                       for keys in ratio_groups]
             lines.append("| " + " | ".join([preset, label] + cells(s) + ratios) + " |")
     return lines
 
+# (d) / (a) when those are the cases (the tables as before (e) was added).
+versus = "(d) / (a)" if cases == ["a", "d"] else "/ (a)"
 bob = "" if bob_hz == "0" else f", the body bobbing at {bob_hz} Hz"
 rows = [f"{rate_hz} Hz, {num_seeds} seeds, 1080 rows{bob}; RMS over the non-reference cameras "
         "of every seed; z = error / sigma", ""]
 rows += table("| preset | case | cameras | rotation (deg) | centre x, y, z (mm) | centre (mm) "
-              "| rotation z | centre z (per axis) | largest abs z | (d) / (a): rotation, centre "
-              "| sigma (d) / (a): rotation, centre |",
+              f"| rotation z | centre z (per axis) | largest abs z | {versus}: rotation, centre "
+              f"| sigma {versus}: rotation, centre |",
               lambda s: [str(s["n"]), f"{s['rotation']:.4f}",
                          ", ".join(f"{1e3 * v:.3f}" for v in s["axes"]),
                          f"{1e3 * s['centre']:.3f}", f"{s['rotation_z']:.2f}",
@@ -231,7 +276,7 @@ rows += ["", "Intrinsics, RMS over every camera of every seed (the reference cam
          "the lens's", ""]
 rows += table("| preset | case | cameras | another model | focal (%) | principal point (px) "
               "| projection, max (px) | focal z | principal point z | largest abs z "
-              "| (d) / (a): focal, principal point, projection |",
+              f"| {versus}: focal, principal point, projection |",
               lambda s: [str(s["intrinsics_n"]), str(s["other_model"]), f"{s['focal']:.4f}",
                          f"{s['pp']:.3f}", f"{s['projection']:.3f}", f"{s['focal_z']:.2f}",
                          f"{s['pp_z']:.2f}", f"{s['intrinsics_max_z']:.1f}"],
@@ -241,7 +286,7 @@ rows += ["", "The non-reference cameras' rotation errors as turns in the rig fra
          "reference camera; RMS of its size over the seeds, its mean per rig axis +- the "
          "mean's standard error; RMS of each camera's turn about that mean", ""]
 rows += table("| preset | case | seeds | common turn (deg) | its mean x, y, z (deg) "
-              "| each camera's own (deg) | (d) / (a): common, own |",
+              f"| each camera's own (deg) | {versus}: common, own |",
               lambda s: [str(s["seeds"]), f"{s['common']:.4f}",
                          ", ".join(f"{m:+.4f} +- {e:.4f}" for m, e in
                                    zip(s["common_mean"], s["common_mean_sigma"])),
