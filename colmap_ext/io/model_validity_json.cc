@@ -69,6 +69,7 @@ Json ChoiceJson(const ModelChoice& choice) {
          {"num_params", candidate.num_params},
          {"num_inliers", candidate.num_inliers},
          {"chosen", candidate.chosen},
+         {"as_good_as_best", candidate.as_good_as_best},
          {"note", candidate.note}});
   }
   return node;

@@ -13,7 +13,10 @@
 //   "model_choice" (cameras whose model was "auto" only): {"chosen",
 //     "reason", "uncertain" (the choice failed a check; warned),
 //     "candidates": [{"model", "valid", "heldout_rms_px",
-//     "train_rms_px", "num_params", "num_inliers", "chosen", "note"}]}
+//     "train_rms_px", "num_params", "num_inliers", "chosen",
+//     "as_good_as_best" (within the rule's standard errors of the best; the
+//     others of these set the model choice's spread in the uncertainty),
+//     "note"}]}
 #pragma once
 
 #include <nlohmann/json.hpp>

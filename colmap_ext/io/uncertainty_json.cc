@@ -24,6 +24,12 @@ Json CameraJson(const CalibrationUncertainty& uncertainty,
   for (const double stddev : camera.params_stddev) {
     node["params_stddev"].push_back(JsonNumber(stddev));
   }
+  if (!camera.model_choice_stddev.empty()) {
+    node["model_choice_stddev"] = Json::array();
+    for (const double stddev : camera.model_choice_stddev) {
+      node["model_choice_stddev"].push_back(JsonNumber(stddev));
+    }
+  }
   node["rotation_stddev_deg"] = JsonNumber(camera.rotation_stddev_deg);
   node["rotation_axis_stddev_deg"] = Vector(camera.rotation_axis_stddev_deg);
   node["translation_stddev"] = Vector(camera.translation_stddev);
@@ -60,14 +66,12 @@ std::string Fixed(double value, int precision) {
 }
 
 // "0.12" for one focal length, "0.12/0.13" for fx/fy (pixels).
-std::string Joined(const CameraUncertainty& camera,
+std::string Joined(const std::vector<double>& stddevs,
                    const std::vector<size_t>& indices, int precision) {
   std::string text;
   for (const size_t k : indices) {
     if (!text.empty()) text += "/";
-    text += k < camera.params_stddev.size()
-                ? Fixed(camera.params_stddev[k], precision)
-                : "?";
+    text += k < stddevs.size() ? Fixed(stddevs[k], precision) : "?";
   }
   return text;
 }
@@ -105,6 +109,15 @@ void AddUncertaintyComments(const CalibrationUncertainty& uncertainty,
         "calibration_summary.json has all of it): COLMAP " +
         entry.camera->ModelName() + " params (" + entry.camera->ParamsInfo() +
         "): " + params.str());
+    if (!camera.model_choice_stddev.empty()) {
+      std::ostringstream spread;
+      for (size_t k = 0; k < camera.model_choice_stddev.size(); ++k) {
+        spread << (k == 0 ? "" : " ") << Fixed(camera.model_choice_stddev[k], 6);
+      }
+      entry.comments.push_back(
+          "  at least the model choice's spread (another model fits as "
+          "well; 0: the adjustment's is larger): " + spread.str());
+    }
     entry.comments.push_back(
         "  cam_from_rig rotation " + Fixed(camera.rotation_stddev_deg, 5) +
         " deg, centre in the rig (" +
@@ -143,8 +156,8 @@ std::vector<std::string> UncertaintyLines(
     std::ostringstream line;
     line << "  " << std::left << std::setw(8)
          << (c < camera_names.size() ? camera_names[c] : "") << std::right
-         << " f " << Joined(camera, cameras[c].FocalLengthIdxs(), 3) << " pp "
-         << Joined(camera, cameras[c].PrincipalPointIdxs(), 3)
+         << " f " << Joined(camera.params_stddev, cameras[c].FocalLengthIdxs(), 3) << " pp "
+         << Joined(camera.params_stddev, cameras[c].PrincipalPointIdxs(), 3)
          << " px, rotation " << Fixed(camera.rotation_stddev_deg, 4)
          << " deg, centre (" << Fixed(center.x(), 5) << ", "
          << Fixed(center.y(), 5) << ", " << Fixed(center.z(), 5) << ")";
@@ -155,6 +168,15 @@ std::vector<std::string> UncertaintyLines(
            << Fixed(camera.projection.max_at.y(), 0) << ")";
     } else if (!camera.determined) {
       line << ", some parameters undetermined";
+    }
+    if (!camera.model_choice_stddev.empty()) {
+      line << "; f and pp at least the model choice's spread ("
+           << Joined(camera.model_choice_stddev, cameras[c].FocalLengthIdxs(),
+                     3)
+           << ", "
+           << Joined(camera.model_choice_stddev,
+                     cameras[c].PrincipalPointIdxs(), 3)
+           << " px)";
     }
     if (camera.between_framesets_factor > kBetweenFramesetsNoteFactor) {
       line << "; framesets disagree " << Fixed(camera.between_framesets_factor, 1)

@@ -16,7 +16,11 @@ namespace rig_calibrator {
 
 // Per camera c of root["cameras"] (the dataset's order) its
 // "uncertainty": {residual_scale_px, params_stddev (0: held, null:
-// undetermined), rotation_stddev_deg (sqrt of the trace of the rotation
+// undetermined; at least the model choice's spread), model_choice_stddev
+// (that spread per parameter where it is the larger, else 0,
+// src/calibration/model_choice_spread.h; only when the choice on the
+// adjusted rig found another model as good),
+// rotation_stddev_deg (sqrt of the trace of the rotation
 // vector's covariance), rotation_axis_stddev_deg, translation_stddev,
 // center_in_rig_stddev, between_framesets_factor (max over the parameters
 // of the between-framesets sigma over the noise sigma; null when not
@@ -38,7 +42,8 @@ void AddUncertaintyComments(const CalibrationUncertainty& uncertainty,
 constexpr double kBetweenFramesetsNoteFactor = 1.5;
 
 // The lines of the terminal result: per camera sigma of the focal length(s),
-// principal point, rotation and centre, and the projection uncertainty.
+// principal point, rotation and centre, the projection uncertainty, and the
+// model choice's spread when the first two include it.
 std::vector<std::string> UncertaintyLines(
     const std::vector<std::string>& camera_names,
     const std::vector<colmap::Camera>& cameras,

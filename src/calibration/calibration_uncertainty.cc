@@ -1491,6 +1491,15 @@ std::vector<Diagnostic> UncertaintyDiagnostics(
     }
     if (pp_undetermined || pp_stddev > kPoorPrincipalPointStddevPx) {
       const std::vector<size_t> pp = intrinsics.PrincipalPointIdxs();
+      // The pipeline has added the model choice's spread
+      // (model_choice_spread.h) before it diagnoses.
+      bool pp_from_model_choice = false;
+      for (const size_t k : pp) {
+        pp_from_model_choice =
+            pp_from_model_choice ||
+            (k < camera.model_choice_stddev.size() &&
+             camera.model_choice_stddev[k] > kPoorPrincipalPointStddevPx);
+      }
       Diagnostic diagnostic;
       diagnostic.level = Diagnostic::Level::kWarning;
       diagnostic.code = "poorly_determined_principal_point";
@@ -1501,8 +1510,12 @@ std::vector<Diagnostic> UncertaintyDiagnostics(
                : "1-sigma " + format(camera.params_stddev[pp[0]], 2) +
                      " px in x, " + format(camera.params_stddev[pp[1]], 2) +
                      " px in y") +
-          ", above " + format(kPoorPrincipalPointStddevPx, 1) +
-          " px): hold it with --RigCalibrator.refine_principal_point 0 (at "
+          ", above " + format(kPoorPrincipalPointStddevPx, 1) + " px" +
+          (pp_from_model_choice
+               ? std::string(", from the model choice: another camera "
+                             "model fits as well and puts it elsewhere")
+               : std::string()) +
+          "): hold it with --RigCalibrator.refine_principal_point 0 (at "
           "its initial value, the image centre unless given), or add "
           "framesets whose features cover the whole image";
       diagnostic.cameras = {static_cast<int>(c)};

@@ -147,8 +147,15 @@ struct CameraUncertainty {
   // computed.
   bool determined = false;
   // One per model parameter (COLMAP order): 0 for a parameter held fixed,
-  // NaN when undetermined.
+  // NaN when undetermined. After the pipeline's uncertainty stage, the
+  // larger of the adjustment's and the model choice's spread
+  // (model_choice_spread.h).
   std::vector<double> params_stddev;
+  // That spread, one per parameter, where it is the larger (0 elsewhere);
+  // empty when it is nowhere (the choice on the adjusted rig did not run,
+  // found no other candidate as good as the best, or the adjustment's
+  // sigmas are larger).
+  std::vector<double> model_choice_stddev;
   // cam_from_rig: the rotation vector w of R' = Exp(w) R (camera frame) per
   // axis and sqrt(trace Cov_w) (the RMS rotation angle), degrees; the
   // translation per axis and the camera centre in the rig (-R^T t) per axis,
@@ -212,7 +219,8 @@ constexpr double kFramesetsDisagreeFactor = 3.0;
 // standard deviation above kLargeProjectionStddevPx), "poorly_determined_
 // principal_point" (a principal point coordinate's standard deviation above
 // kPoorPrincipalPointStddevPx, or undetermined: suggests
-// --RigCalibrator.refine_principal_point 0), "framesets_disagree" (a
+// --RigCalibrator.refine_principal_point 0; says so when the model choice's
+// spread, model_choice_stddev, is what puts it there), "framesets_disagree" (a
 // camera's between_framesets_factor above kFramesetsDisagreeFactor) and
 // "undetermined_parameters".
 std::vector<Diagnostic> UncertaintyDiagnostics(

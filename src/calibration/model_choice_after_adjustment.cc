@@ -11,6 +11,8 @@
 #include <random>
 #include <set>
 
+#include "src/calibration/model_choice_spread.h"
+
 namespace rig_calibrator {
 namespace {
 
@@ -300,8 +302,12 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
                     kConvergedTolerance, &fits[m]);
     converged[m] = 1;
   };
+  // Per candidate held out, its fits without each fold (the spread's
+  // jackknife, model_choice_spread.h).
+  std::vector<std::vector<colmap::Camera>> fold_cameras(fits.size());
   const auto held_out = [&](size_t m) {
     converge(m);
+    fold_cameras[m].clear();
     std::vector<double> errors(subset.size(), 0);
     for (int fold = 0; fold < num_folds; ++fold) {
       std::vector<int> training;
@@ -314,6 +320,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
       FitRowsForModel(options, rows.points2D, rows.points_rig, training,
                       /*converting=*/false, options.max_num_fold_iterations,
                       kFoldTolerance, &fold_fit);
+      fold_cameras[m].push_back(fold_fit.camera);
       for (size_t e = 0; e < subset.size(); ++e) {
         const int row = subset[e];
         if (fold_of_frameset[rows.framesets[row]] != fold) continue;
@@ -350,6 +357,26 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
   // at the upgrade, which folded inside the image; OPENCV, 0.96 px held
   // out on the adjusted rig, was not taken, and the camera ended 0.16 deg
   // off with the error.
+  // The chosen fit and the candidates as good as the best: how far apart
+  // their focal lengths and principal points are (model_choice_spread.h).
+  const auto finish = [&](int index) {
+    converge(index);
+    *camera = fits[index].camera;
+    *cam_from_rig = fits[index].cam_from_rig;
+    std::vector<AlternativeModelFit> others;
+    for (size_t m = 0; m < choice->candidates.size(); ++m) {
+      if (static_cast<int>(m) == index ||
+          !choice->candidates[m].as_good_as_best) {
+        continue;
+      }
+      others.push_back({fits[m].camera, fold_cameras[m]});
+      choice->spread_models.push_back(choice->candidates[m].model);
+    }
+    if (!others.empty()) {
+      choice->parameter_spread = SharedParameterSpread(*camera, others);
+    }
+    return true;
+  };
   const auto current = std::find_if(
       choice->candidates.begin(), choice->candidates.end(),
       [&](const ModelCandidate& c) { return c.model == camera->ModelName(); });
@@ -384,10 +411,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
                      "against " +
                      current->model + "'s training error: " + comparison +
                      "); among the valid candidates: " + choice->reason;
-    converge(chosen);
-    *camera = fits[chosen].camera;
-    *cam_from_rig = fits[chosen].cam_from_rig;
-    return true;
+    return finish(chosen);
   }
   const int current_index =
       static_cast<int>(current - choice->candidates.begin());
@@ -405,10 +429,7 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
                      "error is worse than the best, and it is not (the rule "
                      "alone: " + choice->reason + ")";
   }
-  converge(chosen);
-  *camera = fits[chosen].camera;
-  *cam_from_rig = fits[chosen].cam_from_rig;
-  return true;
+  return finish(chosen);
 }
 
 }  // namespace rig_calibrator

@@ -109,6 +109,14 @@ struct ModelChoice {
   // says which): the pipeline warns (diagnostic "uncertain_model_choice").
   bool uncertain = false;
   std::vector<ModelCandidate> candidates;
+  // The choice on the adjusted rig only (model_choice_after_adjustment.h):
+  // per parameter of the chosen model, how far its focal lengths and
+  // principal point lie from those of the other candidates that the rule
+  // found as good as the best (model_choice_spread.h; 0 for the other
+  // parameters); empty when no other candidate was. spread_models: those
+  // candidates.
+  std::vector<double> parameter_spread;
+  std::vector<std::string> spread_models;
 };
 
 // points2D, points_cam: as for UpgradeCamera; groups: the frameset of every

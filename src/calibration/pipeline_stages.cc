@@ -11,6 +11,7 @@
 #include "src/calibration/camera_model_stage.h"
 #include "src/calibration/complete_frameset_initialization.h"
 #include "src/calibration/inlier_selection.h"
+#include "src/calibration/model_choice_spread.h"
 
 namespace rig_calibrator {
 namespace {
@@ -429,6 +430,17 @@ void RunUncertaintyEstimation(const PipelineOptions& options,
       dataset, calibration);
   SetCaptureTimeSigmas(report->uncertainty,
                        &report->capture_time_model.cameras);
+  // The model choice's share (model_choice_spread.h): for the cameras whose
+  // model the choice on the adjusted rig set.
+  for (size_t c = 0; c < report->camera_models.size() &&
+                     c < report->uncertainty.cameras.size();
+       ++c) {
+    const std::optional<ModelChoice>& choice = report->camera_models[c].choice;
+    if (choice && choice->chosen == calibration.cameras[c].ModelName()) {
+      AddModelChoiceSpread(choice->parameter_spread,
+                           &report->uncertainty.cameras[c]);
+    }
+  }
   for (const Diagnostic& diagnostic :
        UncertaintyDiagnostics(dataset, calibration, report->uncertainty)) {
     report->diagnostics.push_back(diagnostic);

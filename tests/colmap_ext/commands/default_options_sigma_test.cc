@@ -10,7 +10,9 @@
 // wrong matches, only points with a map track. Every true error is divided
 // by its reported σ, per group: focal length, principal point, distortion
 // (where auto chose the true model), rotation and centre in the rig (per
-// axis; cameras with another model than the truth's apart). A standard
+// axis); cameras with another model than the truth's apart, with their
+// mean focal length and principal point (whose σ includes the model
+// choice's spread, src/calibration/model_choice_spread.h). A standard
 // normal has 0.683 within 1, 0.954 within 2, RMS 1.
 //
 // RIG_CALIBRATOR_SIGMA_RUNS (default 8) sets the number of runs: docs/accuracy.md
@@ -89,8 +91,14 @@ TEST(DefaultOptionsSigma, ErrorsOverSigmaOnMapsLikeSfM) {
   const PipelineOptions pipeline = CommandDefaults();
   std::map<std::string, Group> groups;
   const std::vector<std::string> order = {
-      "focal",    "principal point",        "distortion",
-      "rotation", "centre",                 "rotation, other model",
+      "focal",
+      "principal point",
+      "distortion",
+      "rotation",
+      "centre",
+      "focal, other model",
+      "principal point, other model",
+      "rotation, other model",
       "centre, other model"};
   std::map<std::string, int> chosen;
   for (int run = 0; run < num_runs; ++run) {
@@ -123,8 +131,26 @@ TEST(DefaultOptionsSigma, ErrorsOverSigmaOnMapsLikeSfM) {
       const colmap::Camera& estimated = calibration.cameras[c];
       const colmap::Camera& truth = rig.truth.cameras[c];
       ++chosen[estimated.ModelName()];
-      // Parameters compare only where auto chose the true model.
-      if (estimated.ModelId() == truth.ModelId()) {
+      // Parameters compare only where auto chose the true model; with
+      // another model the focal length (the mean of fx, fy) and the
+      // principal point, whose sigma includes the model choice's spread.
+      if (estimated.ModelId() != truth.ModelId()) {
+        const std::vector<size_t>& focal = estimated.FocalLengthIdxs();
+        double focal_sigma = 0;
+        for (const size_t k : focal) {
+          focal_sigma += sigma.params_stddev[k] / focal.size();
+        }
+        groups["focal, other model"].z.push_back(
+            (estimated.MeanFocalLength() - truth.MeanFocalLength()) /
+            focal_sigma);
+        const std::vector<size_t>& pp = estimated.PrincipalPointIdxs();
+        groups["principal point, other model"].z.push_back(
+            (estimated.PrincipalPointX() - truth.PrincipalPointX()) /
+            sigma.params_stddev[pp[0]]);
+        groups["principal point, other model"].z.push_back(
+            (estimated.PrincipalPointY() - truth.PrincipalPointY()) /
+            sigma.params_stddev[pp[1]]);
+      } else {
         for (size_t k = 0; k < truth.NumParams(); ++k) {
           const std::vector<size_t>& focal = truth.FocalLengthIdxs();
           const std::vector<size_t>& pp = truth.PrincipalPointIdxs();

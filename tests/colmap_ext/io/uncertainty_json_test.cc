@@ -147,5 +147,47 @@ TEST(UncertaintyJson, TerminalLinesNameEveryComputedCamera) {
   EXPECT_NE(lines[2].find("undetermined"), std::string::npos);
 }
 
+// A camera whose focal lengths and principal point come from the model
+// choice's spread (src/calibration/model_choice_spread.h): its
+// "model_choice_stddev" in the summary, a note in its terminal line and a
+// comment in camchain.yaml; a camera without it has none of the three.
+TEST(UncertaintyJson, ModelChoiceSpreadIsShownWhereItIsTheSigma) {
+  CalibrationUncertainty uncertainty = TwoCameras();
+  uncertainty.cameras[0].model_choice_stddev = {0.1, 0.1, 0.2, 0, 0, 0, 0, 0};
+  nlohmann::ordered_json root;
+  root["cameras"] = nlohmann::ordered_json::array(
+      {{{"name", "cam0"}}, {{"name", "cam1"}}, {{"name", "cam2"}}});
+  AddUncertaintyJson(uncertainty, &root);
+  const nlohmann::ordered_json& first = root["cameras"][0]["uncertainty"];
+  ASSERT_EQ(first["model_choice_stddev"].size(), 8u);
+  EXPECT_EQ(first["model_choice_stddev"][2], 0.2);
+  EXPECT_EQ(first["model_choice_stddev"][3], 0);
+  EXPECT_FALSE(root["cameras"][1]["uncertainty"].contains("model_choice_stddev"));
+
+  const std::vector<std::string> lines =
+      UncertaintyLines({"cam0", "cam1", "cam2"},
+                       {OpenCvCamera(), OpenCvCamera(), OpenCvCamera()},
+                       uncertainty);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[1].find("f and pp at least the model choice's spread "
+                          "(0.100/0.100, 0.200/0.000 px)"),
+            std::string::npos)
+      << lines[1];
+  EXPECT_EQ(lines[2].find("model choice"), std::string::npos);
+
+  RigDescription rig;
+  for (int c = 0; c < 2; ++c) {
+    RigDescriptionCamera camera;
+    camera.name = "cam" + std::to_string(c);
+    camera.camera = OpenCvCamera();
+    rig.cameras.push_back(camera);
+  }
+  AddUncertaintyComments(uncertainty, &rig);
+  ASSERT_EQ(rig.cameras[0].comments.size(), 4u);
+  EXPECT_NE(rig.cameras[0].comments[1].find("model choice's spread"),
+            std::string::npos);
+  EXPECT_EQ(rig.cameras[1].comments.size(), 2u);
+}
+
 }  // namespace uncertainty_json_test
 }  // namespace rig_calibrator

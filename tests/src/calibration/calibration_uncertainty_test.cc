@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "src/calibration/final_bundle_adjuster.h"
+#include "src/calibration/model_choice_spread.h"
 #include "src/calibration/pipeline.h"
 #include "src/calibration/pipeline_report.h"
 #include "src/synthetic/synthetic_rig.h"
@@ -427,7 +428,8 @@ TEST(CalibrationUncertainty, UndeterminedCameraIsReportedNotNumbered) {
 
 // With few framesets whose features cluster in a small window, the
 // principal point is poorly determined: the diagnostics say so and suggest
-// holding it; with the whole image covered they do not.
+// holding it; with the whole image covered they do not, unless the model
+// choice's spread puts it there, and then they say so.
 TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
   for (const bool poor : {true, false}) {
     SyntheticRigOptions options = SmallRig(RigPreset::kRing5, 6);
@@ -461,6 +463,27 @@ TEST(CalibrationUncertainty, PoorlyDeterminedPrincipalPointIsDiagnosed) {
     EXPECT_EQ(projection, poor);
     // Independent errors: the framesets agree with the pixel noise.
     EXPECT_FALSE(disagree);
+    if (poor) continue;
+    // The good data with a model choice's spread of 1.5 px in cx on cam1
+    // (model_choice_spread.h): the warning names the model choice.
+    CalibrationUncertainty with_spread = uncertainty;
+    std::vector<double> spread(calibration.cameras[1].NumParams(), 0.0);
+    spread[calibration.cameras[1].PrincipalPointIdxs()[0]] = 1.5;
+    AddModelChoiceSpread(spread, &with_spread.cameras[1]);
+    int num_warnings = 0;
+    for (const Diagnostic& diagnostic :
+         UncertaintyDiagnostics(rig.dataset, calibration, with_spread)) {
+      if (diagnostic.code != "poorly_determined_principal_point") continue;
+      ++num_warnings;
+      EXPECT_EQ(diagnostic.cameras, std::vector<int>{1});
+      EXPECT_NE(diagnostic.message.find("1-sigma 1.50 px in x"),
+                std::string::npos)
+          << diagnostic.message;
+      EXPECT_NE(diagnostic.message.find("from the model choice"),
+                std::string::npos)
+          << diagnostic.message;
+    }
+    EXPECT_EQ(num_warnings, 1);
   }
 }
 

@@ -4,8 +4,10 @@
 // and 2 cm. Exact data: the true model chosen and recovered to ~1e-8;
 // noisy data with wrong matches: the true model (or, for undistorted
 // images, a pinhole) within the noise; a fisheye lens: a fisheye model; a
-// current model that folds inside the image: the valid model that fits.
-// And the choice rule's standard error clustered by frameset.
+// current model that folds inside the image: the valid model that fits;
+// a simpler model chosen over an as-good flexible one: their focal lengths'
+// spread the size of the chosen one's error. And the choice rule's
+// standard error clustered by frameset.
 #include "src/calibration/model_choice_after_adjustment.h"
 
 #include <gtest/gtest.h>
@@ -250,7 +252,8 @@ TEST(ModelChoiceAfterAdjustment, OneFramesetIsNoChoice) {
 // Four framesets: a lens with one focal length and no tangential distortion
 // (RADIAL) seen by a camera whose current model is OPENCV. RADIAL is as good
 // held out, but four clusters do not make that sure, and OPENCV is kept;
-// with twenty framesets RADIAL wins.
+// with twenty framesets RADIAL wins, OPENCV as good, their focal lengths and
+// principal points apart by the noise (the spread).
 TEST(ModelChoiceAfterAdjustment, FewFramesetsKeepTheCurrentModelUnlessItIsWorse) {
   const colmap::Camera truth = MakeCamera(
       "OPENCV", 752, 480, {458.0, 458.0, 367.2, 248.4, -0.283, 0.074, 0, 0});
@@ -263,6 +266,54 @@ TEST(ModelChoiceAfterAdjustment, FewFramesetsKeepTheCurrentModelUnlessItIsWorse)
   const Outcome many =
       Choose(truth, StartCamera("OPENCV", truth), MakeRows(truth, 20, 150, 0.5, 0, 8));
   EXPECT_EQ(many.choice.chosen, "RADIAL") << many.choice.reason;
+  // OPENCV was as good: its fit of the same lens differs by the noise.
+  EXPECT_EQ(many.choice.spread_models, std::vector<std::string>{"OPENCV"});
+  ASSERT_EQ(many.choice.parameter_spread.size(), 5u);
+  // With OPENCV's own jackknife: f 0.07 px, the principal point 0.13 and
+  // 0.12 px (OPENCV's tangential terms trade with it), at the noise level.
+  EXPECT_LT(many.choice.parameter_spread[0], 0.15);
+  EXPECT_LT(many.choice.parameter_spread[1], 0.25);
+  EXPECT_LT(many.choice.parameter_spread[2], 0.25);
+}
+
+// The synthetic fisheye helmet's cam0 (an OPENCV_FISHEYE lens, 150 degrees
+// over the diagonal, k3 and k4 small), whose k3, k4 the noise hides: a
+// simpler model is as good held out, and which one is chosen moves the
+// focal length. Every candidate as good as the best is named in
+// spread_models, and parameter_spread (model_choice_spread.h) holds how
+// far the chosen focal length and principal point may be off if one of
+// them is the lens's (its difference and its own jackknife): here the size
+// of the chosen focal length's error. From exact data the lens's model
+// alone is as good as the best, and there is no spread.
+TEST(ModelChoiceAfterAdjustment, CandidatesAsGoodAsTheBestGiveTheSpread) {
+  const colmap::Camera truth =
+      MakeCamera("OPENCV_FISHEYE", 640, 480,
+                 {300.9, 300.9, 326, 235, 0.020, -0.010, 0.003, -0.0005});
+  const Outcome exact = Choose(truth, StartCamera("RADIAL_FISHEYE", truth),
+                               MakeRows(truth, 20, 150, 0, 0, 10));
+  EXPECT_EQ(exact.choice.chosen, "OPENCV_FISHEYE");
+  EXPECT_TRUE(exact.choice.parameter_spread.empty());
+  EXPECT_TRUE(exact.choice.spread_models.empty());
+
+  const Outcome noisy = Choose(truth, StartCamera("RADIAL_FISHEYE", truth),
+                               MakeRows(truth, 20, 150, 0.5, 0.1, 11));
+  EXPECT_EQ(noisy.choice.chosen, "RADIAL_FISHEYE");
+  EXPECT_EQ(noisy.choice.spread_models,
+            std::vector<std::string>{"OPENCV_FISHEYE"});
+  ASSERT_EQ(noisy.choice.parameter_spread.size(), 5u);
+  // f, cx, cy, k1, k2: the focal length's error (0.23 px) is the size of
+  // its spread (0.22 px), which the principal point's (0.03 and 0.07 px,
+  // OPENCV_FISHEYE's noise) is not; the distortion has none.
+  const double focal_error =
+      std::abs(noisy.camera.MeanFocalLength() - truth.MeanFocalLength());
+  const std::vector<double>& spread = noisy.choice.parameter_spread;
+  EXPECT_GT(focal_error, 0.1);
+  EXPECT_LT(focal_error, 2 * spread[0]);
+  EXPECT_GT(focal_error, 0.5 * spread[0]);
+  EXPECT_LT(spread[1], 0.15);
+  EXPECT_LT(spread[2], 0.15);
+  EXPECT_EQ(spread[3], 0.0);
+  EXPECT_EQ(spread[4], 0.0);
 }
 
 // Candidate 1 (more parameters) beats candidate 0 by 0.02 px^2 per row on
