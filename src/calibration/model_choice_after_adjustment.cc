@@ -346,17 +346,6 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
         "over the whole image";
     return false;
   }
-  // A change is made against the current model's own held-out error: the
-  // others' say nothing of how they do against it. Unless the current model
-  // is not valid over the image when fitted here: kept, it ends the
-  // calibration with an error on this camera, so the best valid candidate
-  // replaces it if its held-out error is as good as the current model's
-  // training error (optimistic for the current model: a replacement must
-  // fit the lens where the data are, not only be valid). On the 500 x 10
-  // benchmark with the time model (seed 2) an OPENCV lens got RADIAL_FISHEYE
-  // at the upgrade, which folded inside the image; OPENCV, 0.96 px held
-  // out on the adjusted rig, was not taken, and the camera ended 0.16 deg
-  // off with the error.
   // The chosen fit and the candidates as good as the best: how far apart
   // their focal lengths and principal points are (model_choice_spread.h).
   const auto finish = [&](int index) {
@@ -377,6 +366,17 @@ bool ChooseModelOnAdjustedRig(const ModelChoiceAfterAdjustmentOptions& options,
     }
     return true;
   };
+  // A change is made against the current model's own held-out error: the
+  // others' say nothing of how they do against it. Unless the current model
+  // is not valid over the image when fitted here: kept, it ends the
+  // calibration with an error on this camera, so the best valid candidate
+  // replaces it if its held-out error is as good as the current model's
+  // training error (optimistic for the current model: a replacement must
+  // fit the lens where the data are, not only be valid). On the 500 x 10
+  // benchmark with the time model (seed 2) an OPENCV lens got RADIAL_FISHEYE
+  // at the upgrade, which folded inside the image; OPENCV, 0.96 px held
+  // out on the adjusted rig, was not taken, and the camera ended 0.16 deg
+  // off with the error.
   const auto current = std::find_if(
       choice->candidates.begin(), choice->candidates.end(),
       [&](const ModelCandidate& c) { return c.model == camera->ModelName(); });
